@@ -1,0 +1,11 @@
+// Each subcommand lives in its own file: it fills its module's Options from the command line and
+// calls the module. main.cpp only registers them.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace lucent::cli {
+
+void register_profile_command(CLI::App& app);
+
+}  // namespace lucent::cli

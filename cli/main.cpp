@@ -1,0 +1,37 @@
+#include <exception>
+#include <iostream>
+
+#include "commands.h"
+#include "lucent/materials/error.h"
+#include "lucent/version.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"lucent: measure translucent materials and show them.\n"
+               "Lengths in mm, coefficients in mm^-1 unless an option says otherwise.",
+               "lucent"};
+  app.set_version_flag("--version", std::string("lucent ") + lucent::kVersion);
+  app.require_subcommand(1);
+  app.fallthrough(false);
+  lucent::cli::register_profile_command(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // One line, naming the option, instead of CLI11's two-line message.
+    std::cerr << "lucent: error: " << e.what() << " (see lucent --help)\n";
+    return 2;
+  } catch (const lucent::Error& e) {
+    std::cerr << "lucent: error: " << e.what() << '\n';
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "lucent: internal error: " << e.what() << '\n';
+    return 3;
+  }
+  return 0;
+}
