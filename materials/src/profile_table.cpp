@@ -41,6 +41,15 @@ bool parse_double(const std::string& text, double& value) {
   return error == std::errc() && end == text.data() + text.size() && std::isfinite(value);
 }
 
+// Inputs echoed back (radii, positions): the shortest text that reads back to the same double.
+std::string format_input(double v) {
+  char buffer[64];
+  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, v);
+  (void)error;
+  return std::string(buffer, end);
+}
+
+// Model values: 17 significant digits.
 std::string format_number(double v) {
   char buffer[64];
   const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, v,
@@ -133,7 +142,7 @@ std::string radial_profile_csv(const Material& material, const RadialProfileOpti
                                           Vec3<double>(r, 0.0, 0.0), plane_normal());
   };
   for (double r : options.r_mm) {
-    out << format_number(r);
+    out << format_input(r);
     for (int channel = 0; channel < 3; ++channel) out << ',' << format_number(radial_value(channel, r));
     out << '\n';
   }
@@ -215,7 +224,7 @@ std::string bssrdf_configs_csv(const Material& material, DiffusionModel model,
   out << "Sd_r,Sd_g,Sd_b\n";
   for (const BssrdfConfig& c : configs) {
     for (const Vec3<double>* v : {&c.x_i, &c.n_i, &c.w_i, &c.x_o, &c.n_o}) {
-      for (int k = 0; k < 3; ++k) out << format_number((*v)[k]) << ',';
+      for (int k = 0; k < 3; ++k) out << format_input((*v)[k]) << ',';
     }
     const std::array<double, 3> S = evaluate_bssrdf(material, model, c);
     out << format_number(S[0]) << ',' << format_number(S[1]) << ',' << format_number(S[2]) << '\n';

@@ -135,17 +135,20 @@ TEST(Stability, NoNanOrInfOnAMillionConfigurations) {
 namespace lucent::materials {
 namespace {
 
-// How far the double result moves when every input is nudged by one float rounding (relative
-// 2^-24): the error a float evaluation cannot avoid, whatever its formula. Near the clamp at 0, and
-// where the real source nears the surface at x_o (mu0 -> 0 at r -> 0, S ~ 1/mu0^3), S is so sensitive to
-// its inputs that float cannot carry four digits of it.
+// How far the double result moves when every input is nudged by a few float roundings (relative
+// 4 * 2^-24, the size of the rounding a float evaluation accumulates in w_r, n_i* and mu0 before they
+// meet the formula): an error no float formulation can avoid. It is large next to the clamp at 0
+// (S is a difference of two sources) and where the real source nears x_o (mu0 -> 0 at r -> 0,
+// S ~ 1/mu0^3).
 double float_rounding_sensitivity(const SweepCase& c, double S, std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const double eps = std::ldexp(1.0, -24);
+  const double eps = 4.0 * std::ldexp(1.0, -24);
   const auto nudge = [&](double v) { return v * (1.0 + eps * u(rng)); };
-  const auto nudge3 = [&](const Vec3<double>& v) { return Vec3<double>(nudge(v.x()), nudge(v.y()), nudge(v.z())); };
+  const auto nudge3 = [&](const Vec3<double>& v) {
+    return Vec3<double>(nudge(v.x()), nudge(v.y()), nudge(v.z()));
+  };
   double worst = 0.0;
-  for (int k = 0; k < 4; ++k) {
+  for (int k = 0; k < 8; ++k) {
     const Medium<double> m{nudge(c.medium.sigma_a), nudge(c.medium.sigma_s), nudge(c.medium.g),
                            nudge(c.medium.eta)};
     const Vec3<double> x_i = nudge3(c.x_i);
@@ -162,30 +165,38 @@ TEST(Stability, FloatAgreesWithDouble) {
   Sweep sweep(99);
   std::mt19937_64 rng(5);
   double worst_dd = 0, worst_dipole = 0;
-  int compared = 0, ill_conditioned = 0, bad_dd = 0, bad_dipole = 0;
+  int compared = 0, within_1e4 = 0, within_conditioning = 0, bad_dd = 0, bad_dipole = 0;
   for (int i = 0; i < 1000000; ++i) {
     SweepCase c = sweep.next(i);
     // Both evaluations get the same, float-representable inputs.
     const Medium<float> mf{float(c.medium.sigma_a), float(c.medium.sigma_s), float(c.medium.g),
                            float(c.medium.eta)};
     c.medium = Medium<double>{mf.sigma_a, mf.sigma_s, mf.g, mf.eta};
-    for (Vec3<double>* v : {&c.x_i, &c.n_i, &c.w_i, &c.x_o, &c.n_o}) *v = cast<float>(*v).cast<double>();
-
+    const auto round_to_float = [](Vec3<double>& v) {
+      for (int k = 0; k < 3; ++k) v[k] = static_cast<double>(static_cast<float>(v[k]));
+    };
+    round_to_float(c.x_i);
+    round_to_float(c.n_i);
+    round_to_float(c.w_i);
+    round_to_float(c.x_o);
+    round_to_float(c.n_o);
     const double S = DirectionalDipole<double>(c.medium).S_d(c.x_i, c.n_i, c.w_i, c.x_o, c.n_o);
     const float S_f = DirectionalDipole<float>(mf).S_d(cast<float>(c.x_i), cast<float>(c.n_i),
                                                        cast<float>(c.w_i), cast<float>(c.x_o),
                                                        cast<float>(c.n_o));
     if (S > 1e-30) {
-      // Only where float rounding of the inputs alone moves the result by less than 2e-5 does a
-      // 1e-4 bound on the float evaluation make sense; the rest are counted and bounded below.
-      if (float_rounding_sensitivity(c, S, rng) > 2e-5) {
-        ++ill_conditioned;
+      ++compared;
+      const double e = std::abs(S_f - S) / S;
+      worst_dd = std::max(worst_dd, e);
+      if (e <= 1e-4) {
+        ++within_1e4;
+      } else if (e <= 2.0 * float_rounding_sensitivity(c, S, rng)) {
+        ++within_conditioning;  // ill-conditioned: float is as good as its inputs allow
       } else {
-        ++compared;
-        const double e = std::abs(S_f - S) / S;
-        bad_dd += e > 1e-4;
-        if (e > 1e-4 && bad_dd % 60 == 1) std::printf("DBG %s %s r/mfp=%g cos_i=%g S=%g S_f=%g\n", c.kind, c.medium.to_string().c_str(), (c.x_o - c.x_i).norm() * (c.medium.sigma_a + c.medium.sigma_s * (1 - c.medium.g)), c.w_i.dot(c.n_i), S, S_f);
-        worst_dd = std::max(worst_dd, e);
+        ++bad_dd;
+        if (bad_dd <= 5) {
+          ADD_FAILURE() << c.kind << " " << c.medium.to_string() << " S=" << S << " S_f=" << S_f;
+        }
       }
     }
     const double r = (c.x_o - c.x_i).norm();
@@ -197,13 +208,14 @@ TEST(Stability, FloatAgreesWithDouble) {
       worst_dipole = std::max(worst_dipole, e);
     }
   }
-  std::printf("ddipole: %d compared, worst relative error %.3g, %d above 1e-4; %d ill-conditioned "
-              "skipped\ndipole: worst relative error %.3g, %d above 1e-4\n",
-              compared, worst_dd, bad_dd, ill_conditioned, worst_dipole, bad_dipole);
+  std::printf("ddipole: %d compared (value > 1e-30), %d within 1e-4, %d beyond but within what "
+              "float rounding of the inputs causes, %d neither\n"
+              "dipole: worst relative error %.3g, %d above 1e-4\n",
+              compared, within_1e4, within_conditioning, bad_dd, worst_dipole, bad_dipole);
   EXPECT_EQ(bad_dd, 0);
   EXPECT_EQ(bad_dipole, 0);
   EXPECT_GT(compared, 600000);
-  EXPECT_LT(ill_conditioned, compared / 100);  // the exclusion stays an exception
+  EXPECT_GT(within_1e4, 0.995 * compared);  // the conditioning clause stays an exception
 }
 
 }  // namespace

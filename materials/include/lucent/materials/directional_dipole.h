@@ -36,10 +36,15 @@ class DirectionalDipole {
     // Modified tangent-plane normal n_i* = (x / r) x normalize(n_i x x); n_i itself where that is
     // undefined (x_o = x_i, or x along n_i).
     Vec3<T> n_star = n_i;
+    // x . n_i*: exactly 0 when n_i* is the modified normal (perpendicular to x by construction);
+    // taken as 0 rather than computed, whose rounding (eps r) would swamp the virtual source's offset
+    // a^2 - 2 a (x . n_i*) at r of thousands of mean free paths.
+    T x_n = x.dot(n_i);
     const Vec3<T> nx = n_i.cross(x);
     const T nx2 = nx.squaredNorm();
     if (r2 > T(0) && nx2 > T(1e-24) * r2) {
       n_star = (x / r).cross(nx / sqrt(nx2));
+      x_n = T(0);
     }
 
     // Refracted direction of the real source (Snell with relative index 1/eta). Beyond the critical
@@ -72,7 +77,6 @@ class DirectionalDipole {
     // Virtual source x_v = x_i + a n_i*, a = 2 A d_e; from it x_o - x_v = x - a n_i*, so
     // d_v^2 = r^2 + a^2 - 2 a (x . n_i*), again as an offset from r^2.
     const T a = T(2) * c_.A_ddipole * c_.d_e;
-    const T x_n = x.dot(n_star);
     const Vec3<T> x_ov = x - a * n_star;
     T virtual_offset = a * a - T(2) * a * x_n;
     // The virtual source lies outside the medium, 2 A d_e from x_i; only a configuration with x_o off
@@ -81,8 +85,8 @@ class DirectionalDipole {
     if (r2 + virtual_offset < min_d2) virtual_offset = min_d2 - r2;
 
     return difference_of_sources(x, w_r, r2 + real_offset, x_ov, w_v, r2 + virtual_offset,
-                                 virtual_offset - real_offset, a, T(2) * w_r.dot(n_star), n_star,
-                                 n_o);
+                                 virtual_offset - real_offset, a, T(2) * w_r.dot(n_star), x_n,
+                                 n_star, n_o);
   }
 
   const Medium<T>& medium() const { return medium_; }
@@ -112,8 +116,8 @@ class DirectionalDipole {
   // test holds the two together to 1e-10). Where the virtual source is much the weaker (F < 1/2, as at
   // low albedo, where it sits far above the surface) the plain B_r - B_v F is the better form.
   T difference_of_sources(const Vec3<T>& x, const Vec3<T>& w_r, T d_r2, const Vec3<T>& x_ov,
-                          const Vec3<T>& w_v, T d_v2, T delta2, T a, T b, const Vec3<T>& n_star,
-                          const Vec3<T>& n_o) const {
+                          const Vec3<T>& w_v, T d_v2, T delta2, T a, T b, T x_n,
+                          const Vec3<T>& n_star, const Vec3<T>& n_o) const {
     using std::exp;
     using std::expm1;
     using std::log;
@@ -153,7 +157,7 @@ class DirectionalDipole {
       bracket = B_r - B_v * exp(log_F);
     } else {
       const T d_u = sigma * dd;                                // u_r - u_v
-      const T d_yw = b * x.dot(n_star) - a * w_r.dot(n_star);  // (y.w)_r - (y.w)_v
+      const T d_yw = b * x_n - a * w_r.dot(n_star);  // (y.w)_r - (y.w)_v
       const T d_wn = b * n_star.dot(n_o);                      // (w.n_o)_r - (w.n_o)_v
       const T d_yn = a * n_star.dot(n_o);                      // (y.n_o)_r - (y.n_o)_v
       const T d_q = delta2 * q_r * q_v;                        // 1/d_r^2 - 1/d_v^2
