@@ -7,5 +7,6 @@
 namespace lucent::cli {
 
 void register_profile_command(CLI::App& app);
+void register_simulate_command(CLI::App& app);
 
 }  // namespace lucent::cli

@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.fallthrough(false);
   lucent::cli::register_profile_command(app);
+  lucent::cli::register_simulate_command(app);
 
   try {
     app.parse(argc, argv);

@@ -104,4 +104,43 @@ void AtomicOutputPath::commit() {
   committed_ = true;
 }
 
+AtomicOutputDir::AtomicOutputDir(std::filesystem::path target) : target_(std::move(target)) {
+  std::filesystem::path parent = target_.parent_path();
+  if (parent.empty()) parent = ".";
+  if (!std::filesystem::is_directory(parent)) {
+    throw Error(target_.string() + ": cannot write: the folder " + parent.string() + " does not exist");
+  }
+  if (std::filesystem::exists(target_) && !std::filesystem::is_directory(target_)) {
+    throw Error(target_.string() + ": cannot write: exists and is not a folder");
+  }
+  const std::string name = target_.filename().empty() ? target_.parent_path().filename().string()
+                                                      : target_.filename().string();
+  temporary_ = parent / ("." + name + temporary_suffix());
+  std::error_code ec;
+  std::filesystem::create_directory(temporary_, ec);
+  if (ec) throw Error(target_.string() + ": cannot write: " + ec.message());
+}
+
+AtomicOutputDir::~AtomicOutputDir() {
+  if (!committed_) {
+    std::error_code ignored;
+    std::filesystem::remove_all(temporary_, ignored);
+  }
+}
+
+void AtomicOutputDir::commit() {
+  std::error_code ec;
+  if (!std::filesystem::exists(target_)) {
+    std::filesystem::rename(temporary_, target_, ec);
+    if (ec) throw Error(target_.string() + ": cannot write: " + ec.message());
+  } else {
+    for (const auto& entry : std::filesystem::directory_iterator(temporary_)) {
+      std::filesystem::rename(entry.path(), target_ / entry.path().filename(), ec);
+      if (ec) throw Error((target_ / entry.path().filename()).string() + ": cannot write: " + ec.message());
+    }
+    std::filesystem::remove_all(temporary_, ec);
+  }
+  committed_ = true;
+}
+
 }  // namespace lucent

@@ -32,4 +32,26 @@ class AtomicOutputPath {
   bool committed_ = false;
 };
 
+/// An output folder that appears whole or not at all: files are written into a temporary sibling
+/// folder; commit() renames it to the target (or, when the target already exists, moves each file
+/// into it, replacing files of the same name); the destructor removes the temporary folder if
+/// commit() was not called, leaving the target exactly as it was.
+class AtomicOutputDir {
+ public:
+  explicit AtomicOutputDir(std::filesystem::path target);
+  ~AtomicOutputDir();
+  AtomicOutputDir(const AtomicOutputDir&) = delete;
+  AtomicOutputDir& operator=(const AtomicOutputDir&) = delete;
+
+  /// Where to write: `temporary() / name` for each file.
+  const std::filesystem::path& temporary() const { return temporary_; }
+  const std::filesystem::path& target() const { return target_; }
+  void commit();
+
+ private:
+  std::filesystem::path target_;
+  std::filesystem::path temporary_;
+  bool committed_ = false;
+};
+
 }  // namespace lucent

@@ -1,0 +1,51 @@
+// `lucent simulate`: a virtual capture rig. Monte Carlo transport (photon_transport.h) gives the exit
+// radiance toward the camera; the camera model (camera.h) turns it into brackets, with a white
+// reference and a dark frame, and a capture file that `lucent acquire` reads.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "lucent/acquire/camera.h"
+#include "lucent/acquire/photon_transport.h"
+#include "lucent/materials/material.h"
+
+namespace lucent::acquire {
+
+struct SimulateOptions {
+  materials::Material material;
+  PhotonTransportOptions transport;  ///< media are filled from `material`
+  CameraOptions camera;
+  bool white_reference = true;       ///< image a Lambertian reference of reflectance 0.99
+  double white_reflectance = 0.99;
+  /// Beam radius (1/e^2 half width / 2, i.e. the Gaussian sigma) on the white reference, mm; the
+  /// pencil beam of the sample simulation is idealised, a reference spot needs some width to be
+  /// imaged. 0 = one pixel pitch.
+  double white_spot_sigma_mm = 0;
+  bool dark_frame = true;
+  bool profile_only = false;         ///< skip the images (transport without camera)
+  std::optional<std::filesystem::path> exitance_csv;  ///< also write the radial table here
+};
+
+struct SimulateSummary {
+  PhotonTransportResult transport;
+  double camera_scale = 0;           ///< electrons per (radiance x s)
+  std::vector<std::string> files;    ///< written, relative to the output folder
+};
+
+/// Runs the rig and writes into `out_dir` (atomically, as a whole folder): capture.json, bracket
+/// PNGs, white-reference PNGs, dark.png, truth.json (the material and every setting), and
+/// truth_radiance.exr / truth_radiance_se.exr (the exit radiance per unit power and its standard
+/// error, mm^-2 sr^-1) — or only truth.json with `profile_only`.
+SimulateSummary run_simulation(const SimulateOptions& options, const std::filesystem::path& out_dir,
+                               const PhotonTransportProgress& progress = {});
+
+/// The radiance image of a Lambertian reference of reflectance rho lit by the same beam (unit power):
+/// rho / pi times a Gaussian spot of width sigma_mm integrated over each pixel (per mm^2), so that
+/// the image integrated over the plane is rho / pi exactly, up to the spot's tail beyond the grid.
+ImageRgb white_reference_radiance(int size, double pixel_mm, double rho, double sigma_mm);
+
+}  // namespace lucent::acquire

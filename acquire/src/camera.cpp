@@ -1,0 +1,69 @@
+#include "lucent/acquire/camera.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "lucent/materials/error.h"
+
+namespace lucent::acquire {
+namespace {
+
+std::uint64_t splitmix64(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ull;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+}  // namespace
+
+double srgb_encode(double v) {
+  v = std::clamp(v, 0.0, 1.0);
+  return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+}
+
+double srgb_decode(double v) {
+  v = std::clamp(v, 0.0, 1.0);
+  return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+}
+
+double camera_scale(const CameraOptions& options, double peak_radiance) {
+  if (options.electrons_per_radiance_s > 0) return options.electrons_per_radiance_s;
+  if (!(peak_radiance > 0)) throw Error("camera: the image is black, no exposure scale can be chosen");
+  if (options.exposures_s.empty()) throw Error("--exposures: expected at least one exposure time");
+  return options.auto_fill * (options.full_well_e - options.black_level_e) /
+         (peak_radiance * options.exposures_s.front());
+}
+
+RawImage expose(const ImageRgb& radiance, double exposure_s, double scale,
+                const CameraOptions& options, std::uint64_t stream) {
+  if (options.bits != 8 && options.bits != 16) throw Error("--bits: expected 8 or 16");
+  if (options.response == Response::kCalibrate) {
+    throw Error("--response: a simulated camera is 'linear' or 'srgb'");
+  }
+  const int max_value = options.bits == 8 ? 255 : 65535;
+  RawImage out(radiance.width, radiance.height, max_value);
+  std::mt19937_64 rng(splitmix64(options.seed ^ splitmix64(stream)));
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  for (std::size_t i = 0; i < radiance.data.size(); ++i) {
+    const double signal = std::max(0.0, double(radiance.data[i])) * exposure_s * scale;
+    double electrons = signal;
+    if (options.noise) {
+      // Poisson shot noise: exact below 1e4 expected electrons, Gaussian (its limit) above.
+      if (signal < 1e4) {
+        electrons = double(std::poisson_distribution<long long>(signal)(rng));
+      } else {
+        electrons = signal + std::sqrt(signal) * gauss(rng);
+      }
+      electrons += options.read_noise_e * gauss(rng);
+    }
+    electrons += options.black_level_e;
+    const double linear = std::clamp(electrons / options.full_well_e, 0.0, 1.0);
+    const double encoded = options.response == Response::kSrgb ? srgb_encode(linear) : linear;
+    out.data[i] = static_cast<std::uint16_t>(std::lround(encoded * max_value));
+  }
+  return out;
+}
+
+}  // namespace lucent::acquire

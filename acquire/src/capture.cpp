@@ -1,0 +1,251 @@
+#include "lucent/acquire/capture.h"
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "lucent/materials/atomic_file.h"
+#include "lucent/materials/error.h"
+
+namespace lucent::acquire {
+namespace {
+
+using nlohmann::json;
+
+class FieldReader {
+ public:
+  explicit FieldReader(std::string source) : source_(std::move(source)) {}
+
+  [[noreturn]] void fail(const std::string& field, const std::string& what) const {
+    throw Error(source_ + ": field '" + field + "': " + what);
+  }
+
+  double number(const json& value, const std::string& field) const {
+    if (!value.is_number()) fail(field, "expected a number, found " + describe(value));
+    const double v = value.get<double>();
+    if (!std::isfinite(v)) fail(field, "expected a finite number");
+    return v;
+  }
+
+  std::string string(const json& value, const std::string& field) const {
+    if (!value.is_string() || value.get<std::string>().empty()) {
+      fail(field, "expected a non-empty string, found " + describe(value));
+    }
+    return value.get<std::string>();
+  }
+
+  const json& object(const json& value, const std::string& field) const {
+    if (!value.is_object()) fail(field, "expected an object, found " + describe(value));
+    return value;
+  }
+
+  void only_known(const json& object, const std::string& prefix,
+                  const std::set<std::string>& known) const {
+    for (const auto& [key, value] : object.items()) {
+      if (!known.count(key)) {
+        std::string list;
+        for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+        fail(prefix + key, "unknown field (known: " + list + ")");
+      }
+    }
+  }
+
+  static std::string describe(const json& value) {
+    if (value.is_null()) return "null";
+    if (value.is_string()) return "a string";
+    if (value.is_boolean()) return "a boolean";
+    if (value.is_number()) return "a number";
+    if (value.is_array()) return "an array";
+    return "an object";
+  }
+
+ private:
+  std::string source_;
+};
+
+ImageSet read_image_set(const json& doc, const std::string& prefix, const FieldReader& in) {
+  ImageSet set;
+  const bool has_images = doc.contains("images"), has_hdr = doc.contains("hdr");
+  if (has_images == has_hdr) {
+    in.fail(prefix + "images", "expected exactly one of '" + prefix + "images' (brackets) or '" +
+                                   prefix + "hdr' (an OpenEXR file)");
+  }
+  if (has_hdr) {
+    set.hdr = in.string(doc["hdr"], prefix + "hdr");
+    return set;
+  }
+  const json& images = doc["images"];
+  if (!images.is_array() || images.empty()) {
+    in.fail(prefix + "images", "expected a non-empty array of {\"path\", \"exposure_s\"}");
+  }
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    const std::string field = prefix + "images[" + std::to_string(i) + "]";
+    const json& image = in.object(images[i], field);
+    in.only_known(image, field + ".", {"path", "exposure_s"});
+    if (!image.contains("path")) in.fail(field + ".path", "missing");
+    if (!image.contains("exposure_s")) in.fail(field + ".exposure_s", "missing");
+    Bracket b{in.string(image["path"], field + ".path"),
+              in.number(image["exposure_s"], field + ".exposure_s")};
+    if (!(b.exposure_s > 0)) in.fail(field + ".exposure_s", "expected an exposure time > 0 s");
+    if (!set.images.empty() && !(b.exposure_s > set.images.back().exposure_s)) {
+      in.fail(field + ".exposure_s",
+              "exposures must increase strictly from one image to the next (got " +
+                  std::to_string(b.exposure_s) + " s after " +
+                  std::to_string(set.images.back().exposure_s) + " s)");
+    }
+    set.images.push_back(b);
+  }
+  return set;
+}
+
+json image_set_to_json(const ImageSet& set) {
+  json doc = json::object();
+  if (set.hdr) {
+    doc["hdr"] = set.hdr->generic_string();
+  } else {
+    doc["images"] = json::array();
+    for (const Bracket& b : set.images) {
+      doc["images"].push_back({{"path", b.path.generic_string()}, {"exposure_s", b.exposure_s}});
+    }
+  }
+  return doc;
+}
+
+}  // namespace
+
+std::string to_string(Response response) {
+  switch (response) {
+    case Response::kLinear: return "linear";
+    case Response::kSrgb: return "srgb";
+    case Response::kCalibrate: return "calibrate";
+  }
+  return "linear";
+}
+
+Capture read_capture(const std::filesystem::path& path) {
+  const std::string source = path.string();
+  std::ifstream file(path);
+  if (!file) throw Error(source + ": cannot open the capture file");
+  json doc;
+  try {
+    doc = json::parse(file);
+  } catch (const json::parse_error& e) {
+    std::string what = e.what();
+    const auto colon = what.find("]: ");  // drop nlohmann's "[json.exception.parse_error.101]"
+    throw Error(source + ": not valid JSON: " + (colon != std::string::npos ? what.substr(colon + 3) : what));
+  }
+  const FieldReader in(source);
+  if (!doc.is_object()) throw Error(source + ": expected a JSON object (a lucent-capture file)");
+  in.only_known(doc, "", {"format", "version", "images", "hdr", "pixel_pitch_mm", "incidence",
+                          "view_deg", "beam_point_px", "response", "dark", "white_reference",
+                          "beam_power", "provenance"});
+  if (!doc.contains("format")) in.fail("format", "missing (expected \"lucent-capture\")");
+  if (doc["format"] != "lucent-capture") {
+    in.fail("format", "expected \"lucent-capture\", found " + doc["format"].dump());
+  }
+  if (!doc.contains("version") || !doc["version"].is_number_integer()) {
+    in.fail("version", "expected the integer 1");
+  }
+  if (doc["version"].get<long long>() > Capture::kFormatVersion || doc["version"].get<long long>() < 1) {
+    in.fail("version", "this lucent reads capture version 1, found " + doc["version"].dump());
+  }
+
+  Capture c;
+  c.base_dir = path.parent_path();
+  c.sample = read_image_set(doc, "", in);
+  if (!doc.contains("pixel_pitch_mm")) in.fail("pixel_pitch_mm", "missing (pixel size on the sample in mm)");
+  c.pixel_pitch_mm = in.number(doc["pixel_pitch_mm"], "pixel_pitch_mm");
+  if (!(c.pixel_pitch_mm > 0)) in.fail("pixel_pitch_mm", "expected a pixel pitch > 0 mm");
+
+  if (!doc.contains("incidence")) in.fail("incidence", "missing (expected {\"polar_deg\", \"azimuth_deg\"})");
+  const json& incidence = in.object(doc["incidence"], "incidence");
+  in.only_known(incidence, "incidence.", {"polar_deg", "azimuth_deg"});
+  if (!incidence.contains("polar_deg")) in.fail("incidence.polar_deg", "missing");
+  c.incidence_polar_deg = in.number(incidence["polar_deg"], "incidence.polar_deg");
+  if (!(c.incidence_polar_deg >= 0 && c.incidence_polar_deg < 90)) {
+    in.fail("incidence.polar_deg", "expected an angle from the normal in [0, 90) degrees");
+  }
+  if (incidence.contains("azimuth_deg")) {
+    c.incidence_azimuth_deg = in.number(incidence["azimuth_deg"], "incidence.azimuth_deg");
+  }
+  if (doc.contains("view_deg")) {
+    c.view_deg = in.number(doc["view_deg"], "view_deg");
+    if (!(c.view_deg >= 0 && c.view_deg < 90)) in.fail("view_deg", "expected [0, 90) degrees");
+  }
+  if (doc.contains("beam_point_px")) {
+    const json& p = doc["beam_point_px"];
+    if (!p.is_array() || p.size() != 2) in.fail("beam_point_px", "expected [x, y] in pixels");
+    c.beam_point_px = std::array<double, 2>{in.number(p[0], "beam_point_px[0]"),
+                                            in.number(p[1], "beam_point_px[1]")};
+  }
+  if (doc.contains("response")) {
+    const std::string r = in.string(doc["response"], "response");
+    if (r == "linear") c.response = Response::kLinear;
+    else if (r == "srgb") c.response = Response::kSrgb;
+    else if (r == "calibrate") c.response = Response::kCalibrate;
+    else in.fail("response", "expected \"linear\", \"srgb\" or \"calibrate\", found \"" + r + "\"");
+  }
+  if (doc.contains("dark")) c.dark = in.string(doc["dark"], "dark");
+  if (doc.contains("white_reference")) {
+    const json& w = in.object(doc["white_reference"], "white_reference");
+    in.only_known(w, "white_reference.", {"images", "hdr", "reflectance"});
+    WhiteReference white;
+    white.images = read_image_set(w, "white_reference.", in);
+    if (!w.contains("reflectance")) in.fail("white_reference.reflectance", "missing (e.g. 0.99)");
+    white.reflectance = in.number(w["reflectance"], "white_reference.reflectance");
+    if (!(white.reflectance > 0 && white.reflectance <= 1)) {
+      in.fail("white_reference.reflectance", "expected a reflectance in (0, 1]");
+    }
+    c.white_reference = white;
+  }
+  if (doc.contains("beam_power")) {
+    c.beam_power = in.number(doc["beam_power"], "beam_power");
+    if (!(*c.beam_power > 0)) in.fail("beam_power", "expected a power > 0");
+  }
+  if (doc.contains("provenance")) c.provenance = doc["provenance"];
+  return c;
+}
+
+json capture_to_json(const Capture& c) {
+  json doc = json::object();
+  doc["format"] = "lucent-capture";
+  doc["version"] = Capture::kFormatVersion;
+  const json set = image_set_to_json(c.sample);
+  for (const auto& [key, value] : set.items()) doc[key] = value;
+  doc["pixel_pitch_mm"] = c.pixel_pitch_mm;
+  doc["incidence"] = {{"polar_deg", c.incidence_polar_deg}, {"azimuth_deg", c.incidence_azimuth_deg}};
+  doc["view_deg"] = c.view_deg;
+  if (c.beam_point_px) doc["beam_point_px"] = {(*c.beam_point_px)[0], (*c.beam_point_px)[1]};
+  doc["response"] = to_string(c.response);
+  if (c.dark) doc["dark"] = c.dark->generic_string();
+  if (c.white_reference) {
+    json w = image_set_to_json(c.white_reference->images);
+    w["reflectance"] = c.white_reference->reflectance;
+    doc["white_reference"] = w;
+  }
+  if (c.beam_power) doc["beam_power"] = *c.beam_power;
+  if (!c.provenance.is_null()) doc["provenance"] = c.provenance;
+  return doc;
+}
+
+void write_capture(const std::filesystem::path& path, const Capture& capture) {
+  // Keep "format" and "version" first for a person opening the file.
+  const json doc = capture_to_json(capture);
+  std::ostringstream out;
+  out << "{\n  \"format\": \"lucent-capture\",\n  \"version\": " << Capture::kFormatVersion;
+  for (const auto& [key, value] : doc.items()) {
+    if (key == "format" || key == "version") continue;
+    std::string text = value.dump(2);
+    std::string indented;
+    for (char ch : text) {
+      indented += ch;
+      if (ch == '\n') indented += "  ";
+    }
+    out << ",\n  \"" << key << "\": " << indented;
+  }
+  out << "\n}\n";
+  write_file_atomically(path, out.str());
+}
+
+}  // namespace lucent::acquire

@@ -1,0 +1,862 @@
+// Monte Carlo photon transport in a homogeneous slab (photon_transport.h).
+//
+// The scheme is MCML's (Wang, Jacques and Zheng 1995, "MCML - Monte Carlo modeling of light transport
+// in multi-layered tissues"): packets of weight, exponential free paths with sigma_t, implicit capture
+// (at each collision the fraction 1 - albedo of the weight is deposited and the packet goes on with the
+// rest), Henyey-Greenstein scattering, Russian roulette below a weight of 1e-4 with survival 1/10,
+// Fresnel reflection at the boundaries. Deviations and choices, with the reasons:
+//
+// * Boundaries are scored stochastically by default (reflect with probability R, else escape with the
+//   whole weight), not split as in MCML. Splitting lowers the variance of the totals a little, but the
+//   reflected remnant goes on walking: in the high-albedo materials this simulator exists for, a walk
+//   that returns to the surface is about as long again as the first one, so a photon costs ~2x the
+//   collisions. Measured efficiency 1 / (variance x time) of diffuse_reflectance and of R(r) at 5 mm,
+//   stochastic over split, one thread: see the report in the task history / README (marble red 1.6x,
+//   potato red 1.5x, skim milk red 1.6x). kSplit stays available for comparison with MCML.
+// * Russian roulette is booked exactly: a packet killed with weight w books w as absorbed; a survivor
+//   whose weight grows from w to 10 w books -9 w as absorbed. The expected booked absorption of the
+//   roulette is 0.9 w - 0.1 * 9 w = 0, so `absorbed` stays unbiased, and for every photon
+//   specular + reflected + transmitted + absorbed = 1 exactly (up to floating-point rounding).
+// * The free path left over when a packet meets a boundary is carried over after the reflection
+//   (as MCML does); by the memorylessness of the exponential this is the same as drawing a new one.
+// * The camera image is a next-event estimate at every collision (DESIGN §5): the collision at y with
+//   packet weight w (before absorption) and direction of travel d sends
+//     L += w albedo p_HG(d . w_t) e^(-sigma_t s) T(cos_t) / (eta^2 cos_t A_pixel)
+//   to the pixel containing the exit point y + s w_t, where w_t is the direction inside that refracts
+//   into the camera direction, s = -y_z / cos_t, T the Fresnel transmittance going out. (Radiance
+//   divided by n^2 is conserved across the refraction; the pixel gathers the packet's intensity over
+//   its footprint.) Contributions with sigma_t s > 60 (< 1e-26 of the packet) are skipped.
+// * Determinism: every batch of kPhotonsPerBatch photons draws from its own xoshiro256** stream seeded
+//   from (seed, channel, batch) by splitmix64, and batch tallies are merged into the totals strictly in
+//   batch order, so every sum is formed in the same order whatever the number of threads.
+// * Standard errors come from per-photon sums of squares (the photon's total contribution to each bin,
+//   pixel and total), which is what makes them right with splitting and with correlated contributions
+//   of one photon to neighbouring pixels.
+#include "lucent/acquire/photon_transport.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <exception>
+#include <memory>
+#include <mutex>
+#include <numbers>
+#include <sstream>
+#include <thread>
+
+#include "lucent/materials/error.h"
+#include "lucent/materials/fresnel.h"
+
+namespace lucent::acquire {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kRouletteThreshold = 1e-4;
+constexpr double kRouletteSurvival = 0.1;
+constexpr double kMaxNeeOpticalDepth = 60;
+constexpr int kFineBins = 50;
+constexpr double kFineBinWidthMm = 0.01;
+constexpr double kBinGrowth = 1.05;
+// Memory the in-flight batch tallies may take before fewer batches run ahead of the merge.
+constexpr std::size_t kTallyMemoryBudgetBytes = std::size_t(1) << 30;
+
+// ---------------------------------------------------------------------------------------------
+// Random numbers: xoshiro256** (Blackman and Vigna 2018), seeded by splitmix64.
+
+std::uint64_t splitmix64_next(std::uint64_t& state) {
+  std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+std::uint64_t mix64(std::uint64_t value) { return splitmix64_next(value); }
+
+class Xoshiro256StarStar {
+ public:
+  explicit Xoshiro256StarStar(std::uint64_t seed) {
+    for (auto& word : s_) word = splitmix64_next(seed);
+  }
+
+  std::uint64_t next() {
+    const std::uint64_t result = rotl(s_[1] * 5, 7) * 9;
+    const std::uint64_t t = s_[1] << 17;
+    s_[2] ^= s_[0];
+    s_[3] ^= s_[1];
+    s_[1] ^= s_[2];
+    s_[0] ^= s_[3];
+    s_[2] ^= t;
+    s_[3] = rotl(s_[3], 45);
+    return result;
+  }
+
+  /// Uniform in [0, 1), 53 random bits.
+  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
+  /// Uniform in (0, 1): safe for log.
+  double uniform_open() { return (static_cast<double>(next() >> 11) + 0.5) * 0x1.0p-53; }
+
+ private:
+  static std::uint64_t rotl(std::uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
+  std::uint64_t s_[4];
+};
+
+std::uint64_t stream_seed(std::uint64_t seed, int channel, std::uint64_t batch) {
+  std::uint64_t h = mix64(seed ^ 0x6c7563656e74ULL);  // "lucent"
+  h = mix64(h + static_cast<std::uint64_t>(channel) + 1);
+  return mix64(h ^ (batch * 0xd1342543de82ef95ULL + 1));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Per-channel constants of the transport.
+
+struct Transport {
+  // Medium
+  double sigma_t = 0;      // mm^-1
+  double inv_sigma_t = 0;  // mm (infinity when sigma_t = 0)
+  double albedo = 0;
+  double absorbed_fraction = 1;  // 1 - albedo
+  double g = 0;
+  double hg_1_plus_g2 = 1, hg_1_minus_g2 = 1, hg_inv_2g = 0, hg_pdf_scale = 0;
+  double eta_out = 1;  // relative index going out, 1 / eta
+  bool finite = false;
+  double thickness_mm = 0;
+  // Entry
+  double specular = 0;
+  double w0 = 1;
+  double ux0 = 0, uy0 = 0, uz0 = -1;
+  bool lost_to_depth = false;  // semi-infinite and sigma_t = 0: the refracted beam never comes back
+  // Radial bins
+  const std::vector<double>* edges = nullptr;  // inner edges plus the outer edge
+  double max_radius_mm = 0;
+  // Camera (next-event estimate)
+  bool nee = false;
+  double wt_x = 0, wt_y = 0, wt_z = 1;  // refracted camera direction inside, pointing up
+  double inv_cos_t = 1;
+  double nee_factor = 0;  // albedo T(cos_t) / (eta^2 cos_t A_pixel)
+  double inv_pixel_mm = 0;
+  double half_size = 0;
+  double size_d = 0;
+  int size = 0;
+  double pixel_area_mm2 = 0;
+};
+
+double radians(double degrees) { return degrees * kPi / 180.0; }
+
+Transport make_transport(const PhotonTransportOptions& o, int channel,
+                         const std::vector<double>& edges) {
+  const materials::Medium<double>& m = o.media[static_cast<std::size_t>(channel)];
+  Transport t;
+  t.sigma_t = m.sigma_a + m.sigma_s;
+  t.inv_sigma_t = t.sigma_t > 0 ? 1.0 / t.sigma_t : std::numeric_limits<double>::infinity();
+  t.albedo = t.sigma_t > 0 ? m.sigma_s / t.sigma_t : 0.0;
+  t.absorbed_fraction = 1.0 - t.albedo;
+  t.g = m.g;
+  t.hg_1_plus_g2 = 1 + m.g * m.g;
+  t.hg_1_minus_g2 = 1 - m.g * m.g;
+  t.hg_inv_2g = m.g != 0 ? 1.0 / (2 * m.g) : 0.0;
+  t.hg_pdf_scale = t.hg_1_minus_g2 / (4 * kPi);
+  t.eta_out = 1.0 / m.eta;
+  t.finite = std::isfinite(o.thickness_mm);
+  t.thickness_mm = t.finite ? o.thickness_mm : 0.0;
+
+  // Entry: Fresnel reflection of the beam, refraction by Snell's law.
+  const double theta_i = radians(o.incidence_deg);
+  const double phi_i = radians(o.azimuth_deg);
+  const double cos_i = std::cos(theta_i);
+  t.specular = materials::fresnel_reflectance(cos_i, m.eta);
+  t.w0 = 1.0 - t.specular;
+  const double sin_t = std::sin(theta_i) / m.eta;
+  const double cos_t = sin_t < 1 ? std::sqrt(1 - sin_t * sin_t) : 0.0;
+  t.ux0 = sin_t * std::cos(phi_i);
+  t.uy0 = sin_t * std::sin(phi_i);
+  t.uz0 = -cos_t;
+  t.lost_to_depth = !t.finite && !(t.sigma_t > 0);
+
+  t.edges = &edges;
+  t.max_radius_mm = edges.back();
+
+  if (o.image) {
+    t.size = o.size;
+    t.size_d = o.size;
+    t.half_size = 0.5 * o.size;
+    t.inv_pixel_mm = 1.0 / o.pixel_mm;
+    t.pixel_area_mm2 = o.pixel_mm * o.pixel_mm;
+    // The direction inside that refracts into the camera direction: eta sin(theta_t) = sin(view).
+    const double sin_v = std::sin(radians(o.view_deg));
+    const double sin_vt = sin_v / m.eta;
+    if (sin_vt < 1 && t.sigma_t > 0 && t.albedo > 0) {
+      const double cos_vt = std::sqrt(1 - sin_vt * sin_vt);
+      const double phi_v = radians(o.view_azimuth_deg);
+      t.nee = true;
+      t.wt_x = sin_vt * std::cos(phi_v);
+      t.wt_y = sin_vt * std::sin(phi_v);
+      t.wt_z = cos_vt;
+      t.inv_cos_t = 1.0 / cos_vt;
+      const double T = materials::fresnel_transmittance(cos_vt, t.eta_out);
+      t.nee_factor = t.albedo * T / (m.eta * m.eta * cos_vt * t.pixel_area_mm2);
+    }
+  }
+  return t;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Tallies.
+
+struct Moments {
+  double sum = 0;
+  double sum_sq = 0;
+  void add(double v) {
+    sum += v;
+    sum_sq += v * v;
+  }
+  void add(const Moments& other) {
+    sum += other.sum;
+    sum_sq += other.sum_sq;
+  }
+};
+
+/// Sums over the photons of one batch (or, for the channel totals, of all merged batches).
+struct Tally {
+  int channel = 0;
+  std::uint64_t photons = 0;
+  Moments diffuse, transmitted, absorbed, image_integral;
+  std::uint64_t interactions = 0;
+  std::uint64_t truncated = 0;
+  std::vector<Moments> bins;
+  std::vector<Moments> image;
+  // Pixels with a non-zero sum in this batch. Every contribution is > 0, so sum == 0 means untouched.
+  std::vector<std::int32_t> image_touched;
+
+  Tally(std::size_t bin_count, std::size_t pixel_count) : bins(bin_count), image(pixel_count) {}
+
+  /// Adds `batch` and leaves it empty for reuse.
+  void merge_and_clear(Tally& batch) {
+    photons += batch.photons;
+    diffuse.add(batch.diffuse);
+    transmitted.add(batch.transmitted);
+    absorbed.add(batch.absorbed);
+    image_integral.add(batch.image_integral);
+    interactions += batch.interactions;
+    truncated += batch.truncated;
+    for (std::size_t b = 0; b < bins.size(); ++b) {
+      bins[b].add(batch.bins[b]);
+      batch.bins[b] = {};
+    }
+    for (const std::int32_t p : batch.image_touched) {
+      image[static_cast<std::size_t>(p)].add(batch.image[static_cast<std::size_t>(p)]);
+      batch.image[static_cast<std::size_t>(p)] = {};
+    }
+    batch.image_touched.clear();
+    batch.photons = 0;
+    batch.diffuse = batch.transmitted = batch.absorbed = batch.image_integral = {};
+    batch.interactions = 0;
+    batch.truncated = 0;
+  }
+};
+
+/// One photon's contributions to bins and pixels, gathered so that its per-photon totals can be
+/// squared. Every contribution is > 0, so a zero entry means "not touched yet by this photon".
+struct PhotonScratch {
+  std::vector<double> bins;
+  std::vector<int> bins_touched;
+  std::vector<double> image;
+  std::vector<std::int32_t> image_touched;
+
+  PhotonScratch(std::size_t bin_count, std::size_t pixel_count)
+      : bins(bin_count), image(pixel_count) {
+    bins_touched.reserve(64);
+    image_touched.reserve(std::min<std::size_t>(pixel_count, 4096));
+  }
+};
+
+// ---------------------------------------------------------------------------------------------
+// The transport kernel.
+
+/// cos(phi), sin(phi) of a uniform azimuth, from a uniform point in the unit disc (no trigonometry).
+inline void sample_azimuth(Xoshiro256StarStar& rng, double& cos_phi, double& sin_phi) {
+  double a, b, r2;
+  do {
+    a = 2 * rng.uniform() - 1;
+    b = 2 * rng.uniform() - 1;
+    r2 = a * a + b * b;
+  } while (r2 > 1 || r2 == 0);
+  const double inv = 1.0 / r2;
+  cos_phi = (a * a - b * b) * inv;
+  sin_phi = 2 * a * b * inv;
+}
+
+template <bool kIsotropic, bool kImage, bool kFinite, bool kSplit>
+void trace_photons(const Transport& t, std::uint64_t photons, Xoshiro256StarStar& rng,
+                   PhotonScratch& scratch, Tally& tally) {
+  const std::vector<double>& edges = *t.edges;
+
+  for (std::uint64_t n = 0; n < photons; ++n) {
+    double x = 0, y = 0, z = 0;
+    double ux = t.ux0, uy = t.uy0, uz = t.uz0;
+    double w = t.w0;
+    double reflected = 0, transmitted = 0, absorbed = 0;
+    std::uint64_t interactions = 0;
+
+    auto score_top = [&](double weight) {
+      reflected += weight;
+      const double r = std::sqrt(x * x + y * y);
+      if (r < t.max_radius_mm) {
+        const auto b = static_cast<std::size_t>(
+            std::upper_bound(edges.begin(), edges.end(), r) - edges.begin() - 1);
+        if (scratch.bins[b] == 0) scratch.bins_touched.push_back(static_cast<int>(b));
+        scratch.bins[b] += weight;
+      }
+    };
+    // Returns false when the packet dies.
+    auto roulette = [&]() {
+      if (w >= kRouletteThreshold) return true;
+      if (rng.uniform() < kRouletteSurvival) {
+        absorbed -= w * (1.0 / kRouletteSurvival - 1.0);
+        w *= 1.0 / kRouletteSurvival;
+        return true;
+      }
+      absorbed += w;
+      w = 0;
+      return false;
+    };
+
+    bool alive = w > 0;
+    if (alive && t.lost_to_depth) {
+      transmitted = w;
+      alive = false;
+    }
+    while (alive) {
+      double s = -std::log(rng.uniform_open()) * t.inv_sigma_t;  // free path, mm
+      // Boundaries crossed before the next collision; the rest of the free path carries over.
+      for (;;) {
+        double d;
+        if (uz > 0) {
+          d = -z / uz;
+        } else if (kFinite && uz < 0) {
+          d = (z + t.thickness_mm) / -uz;
+        } else {
+          break;
+        }
+        if (s < d) break;
+        x += ux * d;
+        y += uy * d;
+        const bool top = uz > 0;
+        z = top ? 0.0 : -t.thickness_mm;
+        s -= d;
+        const double R = materials::fresnel_reflectance(std::abs(uz), t.eta_out);
+        if constexpr (kSplit) {
+          const double escaped = w * (1 - R);
+          if (escaped > 0) {
+            if (top) {
+              score_top(escaped);
+            } else {
+              transmitted += escaped;
+            }
+            w -= escaped;
+          }
+          uz = -uz;
+          if (!roulette()) {
+            alive = false;
+            break;
+          }
+        } else {
+          if (R < 1 && !(rng.uniform() < R)) {
+            if (top) {
+              score_top(w);
+            } else {
+              transmitted += w;
+            }
+            w = 0;
+            alive = false;
+            break;
+          }
+          uz = -uz;
+        }
+      }
+      if (!alive) break;
+
+      x += ux * s;
+      y += uy * s;
+      z += uz * s;
+      ++interactions;
+
+      if constexpr (kImage) {
+        if (t.nee) {
+          const double s_exit = -z * t.inv_cos_t;
+          const double fi = (x + s_exit * t.wt_x) * t.inv_pixel_mm + t.half_size;
+          const double fj = (y + s_exit * t.wt_y) * t.inv_pixel_mm + t.half_size;
+          const double tau = t.sigma_t * s_exit;
+          if (fi >= 0 && fi < t.size_d && fj >= 0 && fj < t.size_d && tau < kMaxNeeOpticalDepth) {
+            double phase;
+            if constexpr (kIsotropic) {
+              phase = 1.0 / (4 * kPi);
+            } else {
+              const double denom =
+                  t.hg_1_plus_g2 - 2 * t.g * (ux * t.wt_x + uy * t.wt_y + uz * t.wt_z);
+              phase = t.hg_pdf_scale / (denom * std::sqrt(denom));
+            }
+            const double v = w * t.nee_factor * phase * std::exp(-tau);
+            if (v > 0) {
+              const auto p = static_cast<std::size_t>(static_cast<int>(fj) * t.size +
+                                                      static_cast<int>(fi));
+              if (scratch.image[p] == 0) {
+                scratch.image_touched.push_back(static_cast<std::int32_t>(p));
+              }
+              scratch.image[p] += v;
+            }
+          }
+        }
+      }
+
+      const double deposit = w * t.absorbed_fraction;
+      absorbed += deposit;
+      w -= deposit;
+      if (!roulette()) break;
+      if (interactions >= kMaxInteractionsPerPhoton) {
+        absorbed += w;
+        w = 0;
+        ++tally.truncated;
+        break;
+      }
+
+      // Scatter.
+      double cos_phi, sin_phi;
+      if constexpr (kIsotropic) {
+        const double cos_theta = 2 * rng.uniform() - 1;
+        const double sin_theta = std::sqrt(std::max(0.0, 1 - cos_theta * cos_theta));
+        sample_azimuth(rng, cos_phi, sin_phi);
+        ux = sin_theta * cos_phi;
+        uy = sin_theta * sin_phi;
+        uz = cos_theta;
+      } else {
+        // Henyey-Greenstein inversion (e.g. MCML eq. 3.28), guarded against rounding past +-1.
+        const double tmp = t.hg_1_minus_g2 / (1 - t.g + 2 * t.g * rng.uniform());
+        const double cos_theta =
+            std::clamp((t.hg_1_plus_g2 - tmp * tmp) * t.hg_inv_2g, -1.0, 1.0);
+        const double sin_theta = std::sqrt(std::max(0.0, 1 - cos_theta * cos_theta));
+        sample_azimuth(rng, cos_phi, sin_phi);
+        if (std::abs(uz) > 0.99999) {
+          // Near the pole the general rotation divides by ~0 (MCML's Spin()).
+          ux = sin_theta * cos_phi;
+          uy = sin_theta * sin_phi;
+          uz = uz > 0 ? cos_theta : -cos_theta;
+        } else {
+          const double root = std::sqrt(1 - uz * uz);
+          const double nx = sin_theta * (ux * uz * cos_phi - uy * sin_phi) / root + ux * cos_theta;
+          const double ny = sin_theta * (uy * uz * cos_phi + ux * sin_phi) / root + uy * cos_theta;
+          const double nz = -sin_theta * cos_phi * root + uz * cos_theta;
+          ux = nx;
+          uy = ny;
+          uz = nz;
+        }
+      }
+    }
+
+    // The photon's totals.
+    tally.diffuse.add(reflected);
+    tally.transmitted.add(transmitted);
+    tally.absorbed.add(absorbed);
+    tally.interactions += interactions;
+    for (const int b : scratch.bins_touched) {
+      tally.bins[static_cast<std::size_t>(b)].add(scratch.bins[static_cast<std::size_t>(b)]);
+      scratch.bins[static_cast<std::size_t>(b)] = 0;
+    }
+    scratch.bins_touched.clear();
+    if constexpr (kImage) {
+      double integral = 0;
+      for (const std::int32_t p : scratch.image_touched) {
+        const auto i = static_cast<std::size_t>(p);
+        const double v = scratch.image[i];
+        Moments& m = tally.image[i];
+        if (m.sum == 0) tally.image_touched.push_back(p);
+        m.add(v);
+        integral += v;
+        scratch.image[i] = 0;
+      }
+      scratch.image_touched.clear();
+      tally.image_integral.add(integral * t.pixel_area_mm2);
+    }
+  }
+  tally.photons += photons;
+}
+
+using Kernel = void (*)(const Transport&, std::uint64_t, Xoshiro256StarStar&, PhotonScratch&,
+                        Tally&);
+
+template <bool kIsotropic, bool kImage, bool kFinite>
+Kernel pick_kernel_split(bool split) {
+  return split ? &trace_photons<kIsotropic, kImage, kFinite, true>
+               : &trace_photons<kIsotropic, kImage, kFinite, false>;
+}
+
+template <bool kIsotropic, bool kImage>
+Kernel pick_kernel_finite(bool finite, bool split) {
+  return finite ? pick_kernel_split<kIsotropic, kImage, true>(split)
+                : pick_kernel_split<kIsotropic, kImage, false>(split);
+}
+
+template <bool kIsotropic>
+Kernel pick_kernel_image(bool image, bool finite, bool split) {
+  return image ? pick_kernel_finite<kIsotropic, true>(finite, split)
+               : pick_kernel_finite<kIsotropic, false>(finite, split);
+}
+
+Kernel pick_kernel(const Transport& t, bool image, BoundaryScoring scoring) {
+  // |g| below 1e-6 is sampled as isotropic: the mean cosine is then off by less than 1e-6, while the
+  // HG inversion would lose precision to cancellation (its error grows like 1e-16 / g).
+  const bool isotropic = std::abs(t.g) < 1e-6;
+  const bool split = scoring == BoundaryScoring::kSplit;
+  return isotropic ? pick_kernel_image<true>(image, t.finite, split)
+                   : pick_kernel_image<false>(image, t.finite, split);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Results.
+
+Estimate estimate(const Moments& m, std::uint64_t photons, double scale = 1.0) {
+  const double n = static_cast<double>(photons);
+  const double mean = m.sum / n;
+  Estimate e;
+  e.value = mean * scale;
+  if (photons < 2) {
+    e.standard_error = std::numeric_limits<double>::infinity();
+  } else {
+    const double variance = std::max(0.0, (m.sum_sq / n - mean * mean) * n / (n - 1));
+    e.standard_error = std::sqrt(variance / n) * scale;
+  }
+  return e;
+}
+
+[[noreturn]] void bad_option(const std::string& name, const std::string& expected, double got) {
+  std::ostringstream s;
+  s.precision(17);
+  s << "photon transport: option '" << name << "' must be " << expected << " (got " << got << ")";
+  throw Error(s.str());
+}
+
+std::string format_number(double value) {
+  if (std::isnan(value)) return "nan";
+  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+  char buffer[40];
+  std::snprintf(buffer, sizeof buffer, "%.17g", value);
+  return buffer;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+std::vector<ExitanceBin> exitance_bins(double max_radius_mm) {
+  if (!(max_radius_mm > 0) || !std::isfinite(max_radius_mm)) {
+    bad_option("max_radius_mm", "> 0 and finite", max_radius_mm);
+  }
+  // Width of bin k: 0.01 mm for k < 50 (up to 0.5 mm), then 5% wider per bin.
+  auto width = [](int k) {
+    return k < kFineBins ? kFineBinWidthMm : kFineBinWidthMm * std::pow(kBinGrowth, k - kFineBins + 1);
+  };
+  std::vector<double> edges{0.0};
+  for (int k = 0;; ++k) {
+    const double next = k < kFineBins ? (k + 1) * kFineBinWidthMm : edges.back() + width(k);
+    if (next >= max_radius_mm || max_radius_mm - next < 0.5 * width(k + 1)) {
+      edges.push_back(max_radius_mm);
+      break;
+    }
+    edges.push_back(next);
+  }
+  std::vector<ExitanceBin> bins(edges.size() - 1);
+  for (std::size_t b = 0; b < bins.size(); ++b) {
+    const double ri = edges[b], ro = edges[b + 1];
+    bins[b].r_inner_mm = ri;
+    bins[b].r_outer_mm = ro;
+    bins[b].r_centre_mm = 2.0 / 3.0 * (ro * ro * ro - ri * ri * ri) / (ro * ro - ri * ri);
+  }
+  return bins;
+}
+
+void validate_photon_transport_options(const PhotonTransportOptions& o) {
+  if (o.photons < 1) bad_option("photons", "at least 1", 0);
+  if (!(o.thickness_mm > 0)) bad_option("thickness_mm", "> 0 (infinity: semi-infinite)", o.thickness_mm);
+  if (!(o.incidence_deg >= 0 && o.incidence_deg < 90)) {
+    bad_option("incidence_deg", "in [0, 90)", o.incidence_deg);
+  }
+  if (!std::isfinite(o.azimuth_deg)) bad_option("azimuth_deg", "finite", o.azimuth_deg);
+  if (o.threads < 0) bad_option("threads", ">= 0 (0: all cores)", o.threads);
+  if (!(o.max_radius_mm > 0) || !std::isfinite(o.max_radius_mm)) {
+    bad_option("max_radius_mm", "> 0 and finite", o.max_radius_mm);
+  }
+  if (o.image) {
+    if (o.size < 1 || o.size > 16384) bad_option("size", "in [1, 16384]", o.size);
+    if (!(o.pixel_mm > 0) || !std::isfinite(o.pixel_mm)) {
+      bad_option("pixel_mm", "> 0 and finite", o.pixel_mm);
+    }
+    if (!(o.view_deg >= 0 && o.view_deg < 90)) bad_option("view_deg", "in [0, 90)", o.view_deg);
+    if (!std::isfinite(o.view_azimuth_deg)) {
+      bad_option("view_azimuth_deg", "finite", o.view_azimuth_deg);
+    }
+  }
+  if (!(o.channels[0] || o.channels[1] || o.channels[2])) {
+    throw Error("photon transport: option 'channels' must select at least one channel");
+  }
+  for (int c = 0; c < 3; ++c) {
+    if (!o.channels[static_cast<std::size_t>(c)]) continue;
+    const auto& m = o.media[static_cast<std::size_t>(c)];
+    const std::string prefix = "media[" + std::to_string(c) + "].";
+    if (!(m.sigma_a >= 0) || !std::isfinite(m.sigma_a)) {
+      bad_option(prefix + "sigma_a", ">= 0 and finite (mm^-1)", m.sigma_a);
+    }
+    if (!(m.sigma_s >= 0) || !std::isfinite(m.sigma_s)) {
+      bad_option(prefix + "sigma_s", ">= 0 and finite (mm^-1)", m.sigma_s);
+    }
+    if (!(m.g > -1 && m.g < 1)) bad_option(prefix + "g", "in (-1, 1)", m.g);
+    if (!(m.eta > 0) || !std::isfinite(m.eta)) bad_option(prefix + "eta", "> 0 and finite", m.eta);
+  }
+}
+
+PhotonTransportResult simulate_photon_transport(const PhotonTransportOptions& options,
+                                                const PhotonTransportProgress& progress) {
+  validate_photon_transport_options(options);
+  const auto start = std::chrono::steady_clock::now();
+
+  PhotonTransportResult result;
+  result.options = options;
+  result.seed = options.seed;
+  result.bins = exitance_bins(options.max_radius_mm);
+  std::vector<double> edges;
+  edges.reserve(result.bins.size() + 1);
+  for (const auto& b : result.bins) edges.push_back(b.r_inner_mm);
+  edges.push_back(result.bins.back().r_outer_mm);
+
+  const std::size_t bin_count = result.bins.size();
+  const std::size_t pixel_count =
+      options.image ? static_cast<std::size_t>(options.size) * static_cast<std::size_t>(options.size)
+                    : 0;
+
+  // The work: batches of every selected channel, in channel order. Batch g belongs to channel
+  // job_channel[g] and is that channel's batch number g - first_batch[channel].
+  std::array<Transport, 3> transports;
+  std::array<Kernel, 3> kernels{};
+  std::array<std::uint64_t, 3> first_batch{};
+  std::vector<int> channel_of_range;  // channel per range start, parallel to range_starts
+  std::uint64_t total_batches = 0;
+  std::uint64_t total_photons = 0;
+  const std::uint64_t batches_per_channel =
+      (options.photons + kPhotonsPerBatch - 1) / kPhotonsPerBatch;
+  std::vector<std::unique_ptr<Tally>> channel_totals(3);
+  for (int c = 0; c < 3; ++c) {
+    if (!options.channels[static_cast<std::size_t>(c)]) continue;
+    transports[static_cast<std::size_t>(c)] = make_transport(options, c, edges);
+    kernels[static_cast<std::size_t>(c)] =
+        pick_kernel(transports[static_cast<std::size_t>(c)], options.image, options.boundary_scoring);
+    first_batch[static_cast<std::size_t>(c)] = total_batches;
+    channel_of_range.push_back(c);
+    total_batches += batches_per_channel;
+    total_photons += options.photons;
+    channel_totals[static_cast<std::size_t>(c)] = std::make_unique<Tally>(bin_count, pixel_count);
+    channel_totals[static_cast<std::size_t>(c)]->channel = c;
+  }
+  auto locate = [&](std::uint64_t g, int& channel, std::uint64_t& batch, std::uint64_t& photons) {
+    const std::uint64_t range = g / batches_per_channel;
+    channel = channel_of_range[range];
+    batch = g - first_batch[static_cast<std::size_t>(channel)];
+    photons = batch + 1 < batches_per_channel
+                  ? kPhotonsPerBatch
+                  : options.photons - (batches_per_channel - 1) * kPhotonsPerBatch;
+  };
+
+  const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
+  const std::uint64_t requested = options.threads > 0 ? static_cast<std::uint64_t>(options.threads)
+                                                      : static_cast<std::uint64_t>(hardware);
+  const int workers = static_cast<int>(std::min(requested, total_batches));
+  result.threads_used = workers;
+
+  // Batches may run at most `window` ahead of the merge, which bounds the tallies alive at once.
+  const std::size_t tally_bytes = (bin_count + 1) * sizeof(Moments) +
+                                  pixel_count * (sizeof(Moments) + sizeof(std::int32_t));
+  const std::uint64_t window = static_cast<std::uint64_t>(std::max<std::size_t>(
+      static_cast<std::size_t>(workers),
+      std::min<std::size_t>(2 * static_cast<std::size_t>(workers),
+                            kTallyMemoryBudgetBytes / std::max<std::size_t>(1, tally_bytes))));
+
+  std::mutex mutex;
+  std::condition_variable wake;
+  std::uint64_t next_batch = 0;
+  std::uint64_t next_merge = 0;
+  std::uint64_t photons_merged = 0;
+  bool merging = false;
+  bool failed = false;
+  std::exception_ptr failure;
+  std::vector<std::unique_ptr<Tally>> ready(window);
+  std::vector<std::unique_ptr<Tally>> pool;
+
+  auto worker = [&]() {
+    try {
+      PhotonScratch scratch(bin_count, pixel_count);
+      for (;;) {
+        std::unique_ptr<Tally> tally;
+        std::uint64_t g;
+        {
+          std::unique_lock lock(mutex);
+          wake.wait(lock, [&] {
+            return failed || next_batch >= total_batches || next_batch < next_merge + window;
+          });
+          if (failed || next_batch >= total_batches) return;
+          g = next_batch++;
+          if (!pool.empty()) {
+            tally = std::move(pool.back());
+            pool.pop_back();
+          }
+        }
+        if (!tally) tally = std::make_unique<Tally>(bin_count, pixel_count);
+
+        int channel;
+        std::uint64_t batch, photons;
+        locate(g, channel, batch, photons);
+        tally->channel = channel;
+        Xoshiro256StarStar rng(stream_seed(options.seed, channel, batch));
+        kernels[static_cast<std::size_t>(channel)](transports[static_cast<std::size_t>(channel)],
+                                                    photons, rng, scratch, *tally);
+
+        std::unique_lock lock(mutex);
+        ready[g % window] = std::move(tally);
+        if (merging) continue;  // the merging worker will pick it up
+        merging = true;
+        while (!failed && ready[next_merge % window]) {
+          std::unique_ptr<Tally> done = std::move(ready[next_merge % window]);
+          lock.unlock();
+          // Only the merging worker touches the totals and photons_merged (merging is set).
+          photons_merged += done->photons;
+          channel_totals[static_cast<std::size_t>(done->channel)]->merge_and_clear(*done);
+          if (progress) progress(photons_merged, total_photons);
+          lock.lock();
+          pool.push_back(std::move(done));
+          ++next_merge;
+          wake.notify_all();
+        }
+        merging = false;
+      }
+    } catch (...) {
+      std::lock_guard lock(mutex);
+      if (!failure) failure = std::current_exception();
+      failed = true;
+      wake.notify_all();
+    }
+  };
+
+  if (workers <= 1) {
+    worker();
+  } else {
+    std::vector<std::thread> threads;
+    threads.reserve(static_cast<std::size_t>(workers));
+    for (int i = 0; i < workers; ++i) threads.emplace_back(worker);
+    for (auto& thread : threads) thread.join();
+  }
+  if (failure) std::rethrow_exception(failure);
+
+  for (int c = 0; c < 3; ++c) {
+    ChannelTransportResult& out = result.channels[static_cast<std::size_t>(c)];
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    if (!options.channels[static_cast<std::size_t>(c)]) {
+      out.diffuse_reflectance = out.specular_reflectance = out.transmittance = out.absorbed =
+          out.image_integral = {nan, nan};
+      out.mean_interactions = nan;
+      continue;
+    }
+    const Tally& total = *channel_totals[static_cast<std::size_t>(c)];
+    const Transport& t = transports[static_cast<std::size_t>(c)];
+    const std::uint64_t n = total.photons;
+    out.photons = n;
+    out.diffuse_reflectance = estimate(total.diffuse, n);
+    out.transmittance = estimate(total.transmitted, n);
+    out.absorbed = estimate(total.absorbed, n);
+    out.specular_reflectance = {t.specular, 0.0};
+    out.mean_interactions = static_cast<double>(total.interactions) / static_cast<double>(n);
+    out.photons_truncated = total.truncated;
+    out.exitance.resize(bin_count);
+    for (std::size_t b = 0; b < bin_count; ++b) {
+      const double ri = result.bins[b].r_inner_mm, ro = result.bins[b].r_outer_mm;
+      out.exitance[b] = estimate(total.bins[b], n, 1.0 / (kPi * (ro * ro - ri * ri)));
+    }
+    if (options.image) {
+      out.image.resize(pixel_count);
+      out.image_standard_error.resize(pixel_count);
+      for (std::size_t p = 0; p < pixel_count; ++p) {
+        const Estimate e = estimate(total.image[p], n);
+        out.image[p] = e.value;
+        out.image_standard_error[p] = e.standard_error;
+      }
+      out.image_integral = estimate(total.image_integral, n);
+    }
+  }
+  result.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+std::string exitance_csv(const PhotonTransportResult& result) {
+  const PhotonTransportOptions& o = result.options;
+  std::ostringstream s;
+  auto rgb = [&](auto&& field) {
+    std::string text;
+    for (int c = 0; c < 3; ++c) {
+      if (c > 0) text += ',';
+      text += field(result.channels[static_cast<std::size_t>(c)], c);
+    }
+    return text;
+  };
+  auto rgb_estimate = [&](const std::string& key, Estimate ChannelTransportResult::*member) {
+    s << "# " << key << '=' << rgb([&](const ChannelTransportResult& ch, int) {
+      return format_number(ch.photons > 0 ? (ch.*member).value
+                                          : std::numeric_limits<double>::quiet_NaN());
+    }) << '\n';
+    s << "# " << key << "_se=" << rgb([&](const ChannelTransportResult& ch, int) {
+      return format_number(ch.photons > 0 ? (ch.*member).standard_error
+                                          : std::numeric_limits<double>::quiet_NaN());
+    }) << '\n';
+  };
+  auto rgb_medium = [&](double materials::Medium<double>::*member) {
+    return rgb([&](const ChannelTransportResult&, int c) {
+      return format_number(o.media[static_cast<std::size_t>(c)].*member);
+    });
+  };
+
+  s << "# format=lucent-simulated-exitance version=1\n";
+  s << "# photons=" << rgb([](const ChannelTransportResult& ch, int) {
+    return std::to_string(ch.photons);
+  }) << '\n';
+  s << "# seed=" << result.seed << '\n';
+  s << "# sigma_a_per_mm=" << rgb_medium(&materials::Medium<double>::sigma_a) << '\n';
+  s << "# sigma_s_per_mm=" << rgb_medium(&materials::Medium<double>::sigma_s) << '\n';
+  s << "# g=" << rgb_medium(&materials::Medium<double>::g) << '\n';
+  s << "# eta=" << rgb_medium(&materials::Medium<double>::eta) << '\n';
+  s << "# thickness_mm=" << format_number(o.thickness_mm) << '\n';
+  s << "# incidence_deg=" << format_number(o.incidence_deg)
+    << " azimuth_deg=" << format_number(o.azimuth_deg) << '\n';
+  s << "# max_radius_mm=" << format_number(o.max_radius_mm) << '\n';
+  s << "# boundary_scoring="
+    << (o.boundary_scoring == BoundaryScoring::kSplit ? "split" : "stochastic") << '\n';
+  rgb_estimate("diffuse_reflectance", &ChannelTransportResult::diffuse_reflectance);
+  rgb_estimate("specular_reflectance", &ChannelTransportResult::specular_reflectance);
+  rgb_estimate("transmittance", &ChannelTransportResult::transmittance);
+  rgb_estimate("absorbed", &ChannelTransportResult::absorbed);
+  s << "# units: r_mm in mm (area-weighted bin centre); R_* and se_* per unit incident power, mm^-2\n";
+  s << "r_mm,R_r,R_g,R_b,se_r,se_g,se_b\n";
+  for (std::size_t b = 0; b < result.bins.size(); ++b) {
+    s << format_number(result.bins[b].r_centre_mm);
+    for (int pass = 0; pass < 2; ++pass) {
+      for (int c = 0; c < 3; ++c) {
+        const ChannelTransportResult& ch = result.channels[static_cast<std::size_t>(c)];
+        double value = std::numeric_limits<double>::quiet_NaN();
+        if (ch.photons > 0 && b < ch.exitance.size()) {
+          value = pass == 0 ? ch.exitance[b].value : ch.exitance[b].standard_error;
+        }
+        s << ',' << format_number(value);
+      }
+    }
+    s << '\n';
+  }
+  return s.str();
+}
+
+}  // namespace lucent::acquire

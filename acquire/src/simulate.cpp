@@ -1,0 +1,206 @@
+#include "lucent/acquire/simulate.h"
+
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+#include "lucent/acquire/image_io.h"
+#include "lucent/materials/atomic_file.h"
+#include "lucent/materials/error.h"
+#include "lucent/version.h"
+
+namespace lucent::acquire {
+namespace {
+
+using nlohmann::json;
+
+ImageRgb to_image(const PhotonTransportResult& result, bool standard_error) {
+  const int size = result.options.size;
+  ImageRgb image(size, size);
+  for (int c = 0; c < 3; ++c) {
+    const auto& ch = result.channels[c];
+    const std::vector<double>& values = standard_error ? ch.image_standard_error : ch.image;
+    if (values.empty()) continue;
+    for (int j = 0; j < size; ++j) {
+      for (int i = 0; i < size; ++i) image.at(i, j, c) = float(values[std::size_t(j) * size + i]);
+    }
+  }
+  return image;
+}
+
+double peak(const ImageRgb& image) {
+  double m = 0;
+  for (float v : image.data) m = std::max(m, double(v));
+  return m;
+}
+
+json transport_to_json(const PhotonTransportOptions& o) {
+  return {{"thickness_mm", std::isfinite(o.thickness_mm) ? json(o.thickness_mm) : json("infinite")},
+          {"incidence_deg", o.incidence_deg},
+          {"azimuth_deg", o.azimuth_deg},
+          {"photons_per_channel", o.photons},
+          {"seed", o.seed},
+          {"max_radius_mm", o.max_radius_mm},
+          {"size_px", o.size},
+          {"pixel_mm", o.pixel_mm},
+          {"view_deg", o.view_deg},
+          {"view_azimuth_deg", o.view_azimuth_deg},
+          {"boundary_scoring", o.boundary_scoring == BoundaryScoring::kSplit ? "split" : "stochastic"}};
+}
+
+json camera_to_json(const CameraOptions& o, double scale) {
+  return {{"exposures_s", o.exposures_s},     {"response", to_string(o.response)},
+          {"bits", o.bits},                   {"full_well_e", o.full_well_e},
+          {"read_noise_e", o.read_noise_e},   {"black_level_e", o.black_level_e},
+          {"noise", o.noise},                 {"electrons_per_radiance_s", scale},
+          {"seed", o.seed}};
+}
+
+json totals_to_json(const PhotonTransportResult& r) {
+  json totals = json::object();
+  const auto put = [&](const char* name, auto member) {
+    json values = json::array(), errors = json::array();
+    for (const auto& ch : r.channels) {
+      const Estimate& e = ch.*member;
+      values.push_back(ch.photons ? json(e.value) : json(nullptr));
+      errors.push_back(ch.photons ? json(e.standard_error) : json(nullptr));
+    }
+    totals[name] = values;
+    totals[std::string(name) + "_se"] = errors;
+  };
+  put("diffuse_reflectance", &ChannelTransportResult::diffuse_reflectance);
+  put("specular_reflectance", &ChannelTransportResult::specular_reflectance);
+  put("transmittance", &ChannelTransportResult::transmittance);
+  put("absorbed", &ChannelTransportResult::absorbed);
+  return totals;
+}
+
+std::string bracket_name(const char* stem, std::size_t k) {
+  return std::string(stem) + "_" + std::to_string(k) + ".png";
+}
+
+}  // namespace
+
+ImageRgb white_reference_radiance(int size, double pixel_mm, double rho, double sigma_mm) {
+  ImageRgb image(size, size);
+  // The spot sits where the beam enters: the centre of the grid (x = y = 0 mm).
+  const auto cdf = [&](double x) { return 0.5 * std::erfc(-x / (std::sqrt(2.0) * sigma_mm)); };
+  const double area = pixel_mm * pixel_mm;
+  for (int j = 0; j < size; ++j) {
+    const double y0 = (j - size / 2.0) * pixel_mm;
+    const double py = cdf(y0 + pixel_mm) - cdf(y0);
+    for (int i = 0; i < size; ++i) {
+      const double x0 = (i - size / 2.0) * pixel_mm;
+      const double px = cdf(x0 + pixel_mm) - cdf(x0);
+      const float L = float(rho / std::numbers::pi * px * py / area);
+      for (int c = 0; c < 3; ++c) image.at(i, j, c) = L;
+    }
+  }
+  return image;
+}
+
+SimulateSummary run_simulation(const SimulateOptions& options, const std::filesystem::path& out_dir,
+                               const PhotonTransportProgress& progress) {
+  PhotonTransportOptions transport = options.transport;
+  for (int c = 0; c < 3; ++c) transport.media[c] = options.material.medium(c);
+  transport.image = !options.profile_only;
+  if (!options.profile_only) {
+    if (options.camera.exposures_s.empty()) throw Error("--exposures: expected at least one time");
+    for (std::size_t k = 0; k < options.camera.exposures_s.size(); ++k) {
+      const double t = options.camera.exposures_s[k];
+      if (!(t > 0)) throw Error("--exposures: each exposure must be > 0 s");
+      if (k > 0 && !(t > options.camera.exposures_s[k - 1])) {
+        throw Error("--exposures: exposure times must increase strictly");
+      }
+    }
+    if (options.camera.bits != 8 && options.camera.bits != 16) throw Error("--bits: expected 8 or 16");
+  }
+  validate_photon_transport_options(transport);
+  AtomicOutputDir out(out_dir);  // checks the folder can be made before the long simulation
+
+  SimulateSummary summary;
+  summary.transport = simulate_photon_transport(transport, progress);
+  const PhotonTransportResult& result = summary.transport;
+
+  json truth = {{"format", "lucent-simulation-truth"},
+                {"version", 1},
+                {"material", materials::material_to_json(options.material)},
+                {"transport", transport_to_json(transport)},
+                {"totals", totals_to_json(result)},
+                {"mean_interactions", json::array()},
+                {"wall_seconds", result.wall_seconds},
+                {"threads_used", result.threads_used},
+                {"tool", std::string("lucent simulate ") + kVersion}};
+  for (const auto& ch : result.channels) truth["mean_interactions"].push_back(ch.mean_interactions);
+
+  if (!options.profile_only) {
+    const ImageRgb radiance = to_image(result, false);
+    const double pixel_area = transport.pixel_mm * transport.pixel_mm;
+    const double scale = camera_scale(options.camera, peak(radiance));
+    summary.camera_scale = scale;
+    write_exr(out.temporary() / "truth_radiance.exr", radiance,
+              {{"units", "radiance per unit incident power, mm^-2 sr^-1"}});
+    write_exr(out.temporary() / "truth_radiance_se.exr", to_image(result, true),
+              {{"units", "standard error of truth_radiance, mm^-2 sr^-1"}});
+    summary.files = {"truth_radiance.exr", "truth_radiance_se.exr"};
+
+    Capture capture;
+    capture.pixel_pitch_mm = transport.pixel_mm;
+    capture.incidence_polar_deg = transport.incidence_deg;
+    capture.incidence_azimuth_deg = transport.azimuth_deg;
+    capture.view_deg = transport.view_deg;
+    capture.response = options.camera.response;
+    std::uint64_t stream = 0;
+    for (std::size_t k = 0; k < options.camera.exposures_s.size(); ++k) {
+      const double t = options.camera.exposures_s[k];
+      const std::string name = bracket_name("bracket", k);
+      write_png(out.temporary() / name, expose(radiance, t, scale, options.camera, stream++));
+      capture.sample.images.push_back({name, t});
+      summary.files.push_back(name);
+    }
+    json white_json = nullptr;
+    if (options.white_reference) {
+      const double sigma = options.white_spot_sigma_mm > 0 ? options.white_spot_sigma_mm : transport.pixel_mm;
+      const ImageRgb white = white_reference_radiance(transport.size, transport.pixel_mm,
+                                                      options.white_reflectance, sigma);
+      // The reference is far brighter than the sample: shorten its exposures by a power of two so
+      // that its peak, too, fills about auto_fill of the well at the shortest one.
+      const double ratio = peak(white) / peak(radiance);
+      const double shorten = std::max(1.0, std::exp2(std::ceil(std::log2(ratio))));
+      WhiteReference reference;
+      reference.reflectance = options.white_reflectance;
+      for (std::size_t k = 0; k < options.camera.exposures_s.size(); ++k) {
+        const double t = options.camera.exposures_s[k] / shorten;
+        const std::string name = bracket_name("white", k);
+        write_png(out.temporary() / name, expose(white, t, scale, options.camera, stream++));
+        reference.images.images.push_back({name, t});
+        summary.files.push_back(name);
+      }
+      capture.white_reference = reference;
+      white_json = {{"reflectance", options.white_reflectance}, {"spot_sigma_mm", sigma},
+                    {"exposure_divisor", shorten}};
+    }
+    if (options.dark_frame) {
+      const ImageRgb black(transport.size, transport.size, 0.0f);
+      write_png(out.temporary() / "dark.png",
+                expose(black, options.camera.exposures_s.back(), scale, options.camera, stream++));
+      capture.dark = "dark.png";
+      summary.files.push_back("dark.png");
+    }
+    capture.provenance = {{"tool", std::string("lucent simulate ") + kVersion},
+                          {"material", options.material.name},
+                          {"truth", "truth.json"}};
+    write_capture(out.temporary() / "capture.json", capture);
+    summary.files.push_back("capture.json");
+    truth["camera"] = camera_to_json(options.camera, scale);
+    truth["white_reference"] = white_json;
+    truth["pixel_area_mm2"] = pixel_area;
+  }
+  write_file_atomically(out.temporary() / "truth.json", truth.dump(2) + "\n");
+  summary.files.push_back("truth.json");
+  out.commit();
+  if (options.exitance_csv) write_file_atomically(*options.exitance_csv, exitance_csv(result));
+  return summary;
+}
+
+}  // namespace lucent::acquire

@@ -1,0 +1,161 @@
+// `lucent simulate`: Monte Carlo capture of a material on the virtual rig.
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "commands.h"
+#include "lucent/acquire/simulate.h"
+#include "lucent/materials/error.h"
+
+namespace lucent::cli {
+namespace {
+
+struct SimulateArguments {
+  std::string material;
+  std::string output;
+  std::string exposures = "1/1000,1/250,1/60,1/15,1/4";
+  std::string response = "srgb";
+  std::string exitance_csv;
+  bool no_white = false;
+  bool no_dark = false;
+  bool no_noise = false;
+  bool json = false;
+  bool quiet = false;
+  acquire::SimulateOptions options;
+};
+
+// "1/1000,1/250,0.5" -> seconds.
+std::vector<double> parse_exposures(const std::string& text) {
+  std::vector<double> times;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    const auto slash = item.find('/');
+    double value = 0;
+    try {
+      std::size_t used = 0;
+      if (slash == std::string::npos) {
+        value = std::stod(item, &used);
+        if (used != item.size()) throw std::invalid_argument(item);
+      } else {
+        const std::string num = item.substr(0, slash), den = item.substr(slash + 1);
+        std::size_t u1 = 0, u2 = 0;
+        value = std::stod(num, &u1) / std::stod(den, &u2);
+        if (u1 != num.size() || u2 != den.size()) throw std::invalid_argument(item);
+      }
+    } catch (const std::exception&) {
+      throw Error("--exposures: expected times in s like 1/1000,1/250,0.5, got '" + item + "'");
+    }
+    if (!(value > 0) || !std::isfinite(value)) {
+      throw Error("--exposures: each exposure must be a time > 0 s, got '" + item + "'");
+    }
+    times.push_back(value);
+  }
+  if (times.empty()) throw Error("--exposures: expected at least one exposure time");
+  return times;
+}
+
+void run(SimulateArguments& args) {
+  acquire::SimulateOptions& o = args.options;
+  o.material = materials::load_material(args.material);
+  if (args.response == "srgb") o.camera.response = acquire::Response::kSrgb;
+  else if (args.response == "linear") o.camera.response = acquire::Response::kLinear;
+  else throw Error("--response: expected 'srgb' or 'linear', got '" + args.response + "'");
+  o.camera.exposures_s = parse_exposures(args.exposures);
+  o.camera.noise = !args.no_noise;
+  o.white_reference = !args.no_white;
+  o.dark_frame = !args.no_dark;
+  if (!args.exitance_csv.empty()) o.exitance_csv = args.exitance_csv;
+
+  const auto start = std::chrono::steady_clock::now();
+  auto last = start;
+  const auto progress = [&](std::uint64_t done, std::uint64_t total) {
+    const auto now = std::chrono::steady_clock::now();
+    if (args.quiet || args.json || now - last < std::chrono::seconds(1)) return;
+    last = now;
+    std::cerr << "\rsimulate: " << (100 * done / std::max<std::uint64_t>(total, 1)) << "% of "
+              << total << " photons" << std::flush;
+  };
+  const acquire::SimulateSummary summary = acquire::run_simulation(o, args.output, progress);
+  if (!args.quiet && !args.json && last != start) std::cerr << "\r" << std::string(50, ' ') << "\r";
+
+  const auto& t = summary.transport;
+  if (args.json) {
+    nlohmann::json j = {{"output", args.output}, {"files", summary.files},
+                        {"wall_seconds", t.wall_seconds}, {"threads", t.threads_used},
+                        {"camera_scale", summary.camera_scale}};
+    for (int c = 0; c < 3; ++c) {
+      j["diffuse_reflectance"].push_back(t.channels[c].diffuse_reflectance.value);
+      j["photons"].push_back(t.channels[c].photons);
+    }
+    std::cout << j.dump(2) << '\n';
+  } else if (!args.quiet) {
+    std::cout << "simulated " << o.material.name << ": " << t.channels[0].photons
+              << " photons per channel in " << t.wall_seconds << " s on " << t.threads_used
+              << " threads\n";
+    const char* names = "RGB";
+    for (int c = 0; c < 3; ++c) {
+      const auto& ch = t.channels[c];
+      std::cout << "  " << names[c] << ": diffuse reflectance " << ch.diffuse_reflectance.value
+                << " +- " << ch.diffuse_reflectance.standard_error << ", specular "
+                << ch.specular_reflectance.value << ", transmitted " << ch.transmittance.value
+                << ", absorbed " << ch.absorbed.value << '\n';
+    }
+    std::cout << "wrote " << summary.files.size() << " files to " << args.output << '\n';
+  }
+}
+
+}  // namespace
+
+void register_simulate_command(CLI::App& app) {
+  auto args = std::make_shared<SimulateArguments>();
+  auto& o = args->options;
+  CLI::App* cmd = app.add_subcommand(
+      "simulate",
+      "Virtual capture rig: Monte Carlo photon transport in a slab (Henyey-Greenstein phase, "
+      "Fresnel boundary) lit by a pencil beam of unit power, imaged by a camera model into exposure "
+      "brackets with a white reference and a dark frame. Writes OUTDIR/capture.json for lucent "
+      "acquire, the bracket PNGs, truth.json and truth_radiance.exr (mm^-2 sr^-1 per unit power).");
+  cmd->add_option("--material", args->material, "bundled material name or material file")->required();
+  cmd->add_option("-o,--output", args->output, "output folder (created; written atomically)")->required();
+  cmd->add_option("--photons", o.transport.photons, "photons per colour channel")->capture_default_str();
+  cmd->add_option("--seed", o.transport.seed, "random seed (results identical for any --threads)")
+      ->capture_default_str();
+  cmd->add_option("--threads", o.transport.threads, "worker threads (0 = all cores)")->capture_default_str();
+  cmd->add_option("--thickness-mm", o.transport.thickness_mm,
+                  "slab thickness in mm (default: semi-infinite)");
+  cmd->add_option("--incidence-deg", o.transport.incidence_deg,
+                  "beam angle from the normal, degrees [0, 90)")->capture_default_str();
+  cmd->add_option("--azimuth-deg", o.transport.azimuth_deg,
+                  "beam direction of travel in the image plane, degrees from +x")->capture_default_str();
+  cmd->add_option("--view-deg", o.transport.view_deg,
+                  "camera angle from the normal, degrees [0, 90)")->capture_default_str();
+  cmd->add_option("--view-azimuth-deg", o.transport.view_azimuth_deg,
+                  "camera azimuth, degrees from +x")->capture_default_str();
+  cmd->add_option("--size", o.transport.size, "image width and height, pixels")->capture_default_str();
+  cmd->add_option("--pixel-mm", o.transport.pixel_mm, "pixel pitch on the sample, mm")->capture_default_str();
+  cmd->add_option("--max-radius-mm", o.transport.max_radius_mm,
+                  "outer radius of the radial exitance table, mm")->capture_default_str();
+  cmd->add_option("--exposures", args->exposures, "exposure times in s, increasing")->capture_default_str();
+  cmd->add_option("--response", args->response, "camera encoding: srgb or linear")->capture_default_str();
+  cmd->add_option("--bits", o.camera.bits, "bits per channel: 8 or 16")->capture_default_str();
+  cmd->add_option("--full-well-e", o.camera.full_well_e, "electrons at saturation")->capture_default_str();
+  cmd->add_option("--read-noise-e", o.camera.read_noise_e, "read noise, electrons rms")->capture_default_str();
+  cmd->add_option("--black-level-e", o.camera.black_level_e, "pedestal, electrons")->capture_default_str();
+  cmd->add_option("--camera-scale", o.camera.electrons_per_radiance_s,
+                  "electrons per (radiance x s); 0 = brightest pixel half-fills the well at the "
+                  "shortest exposure")->capture_default_str();
+  cmd->add_flag("--no-noise", args->no_noise, "noise-free camera (exact expected values)");
+  cmd->add_flag("--no-white-reference", args->no_white, "do not image the white reference");
+  cmd->add_flag("--no-dark", args->no_dark, "do not take a dark frame");
+  cmd->add_flag("--profile-only", o.profile_only, "transport only: no images, no capture.json");
+  cmd->add_option("--exitance-csv", args->exitance_csv,
+                  "also write the radial exitance R(r) (mm^-2 per unit power) and totals as CSV");
+  cmd->add_flag("--json", args->json, "print a JSON summary on stdout");
+  cmd->add_flag("-q,--quiet", args->quiet, "no progress or summary");
+  cmd->callback([args] { run(*args); });
+}
+
+}  // namespace lucent::cli

@@ -1,0 +1,77 @@
+// Photons per second of the Monte Carlo photon transport (acquire/photon_transport), semi-infinite
+// slab, normal incidence, one channel: marble red (sigma_a 0.0021, sigma_s' 2.19 /mm, eta 1.5) and
+// potato red (0.0024, 0.68 /mm, eta 1.3). Reference: MCML 1.2.2 does ~1.4e4 (marble) and ~3.2e4
+// (potato) photons per CPU-second on these.
+//
+// items_per_second is photons per second: CPU time of the calling thread for threads=1 (the work runs
+// on it), wall-clock time for threads=2 (UseRealTime; divide by 2 for photons per CPU-second).
+// "image" adds the next-event camera image (128 x 128, 0.1 mm), which MCML does not compute.
+// Run: <build>/tests/benchmarks/bench_photon_transport --benchmark_repetitions=5
+//        --benchmark_report_aggregates_only=true
+#include <benchmark/benchmark.h>
+
+#include <string>
+
+#include "lucent/acquire/photon_transport.h"
+#include "lucent/materials/material.h"
+
+namespace la = lucent::acquire;
+
+namespace {
+
+enum Sample { kMarble = 0, kPotato = 1 };
+
+la::PhotonTransportOptions options_for(int sample, int threads, bool image) {
+  const std::string name = sample == kMarble ? "marble" : "potato";
+  la::PhotonTransportOptions o;
+  o.media[0] = lucent::materials::load_material(name).medium(0);
+  o.channels = {true, false, false};
+  // Four batches, so that two threads share the work evenly.
+  o.photons = 4 * la::kPhotonsPerBatch;
+  o.threads = threads;
+  o.image = image;
+  return o;
+}
+
+void BM_PhotonTransport(benchmark::State& state) {
+  const int sample = static_cast<int>(state.range(0));
+  const int threads = static_cast<int>(state.range(1));
+  const bool image = state.range(2) != 0;
+  la::PhotonTransportOptions o = options_for(sample, threads, image);
+  double interactions = 0;
+  for (auto _ : state) {
+    const la::PhotonTransportResult result = la::simulate_photon_transport(o);
+    interactions = result.channels[0].mean_interactions;
+    benchmark::DoNotOptimize(result.channels[0].diffuse_reflectance.value);
+    ++o.seed;  // fresh photons each iteration, same amount of work on average
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) *
+                          static_cast<std::int64_t>(o.photons));
+  state.counters["interactions_per_photon"] = interactions;
+  state.SetLabel(std::string(sample == kMarble ? "marble red" : "potato red") +
+                 (image ? ", image" : ""));
+}
+
+void photon_transport_arguments(benchmark::internal::Benchmark* b) {
+  b->ArgNames({"sample", "threads", "image"});
+  for (const int sample : {kMarble, kPotato}) {
+    for (const int image : {0, 1}) b->Args({sample, 1, image});
+  }
+}
+
+void photon_transport_threaded_arguments(benchmark::internal::Benchmark* b) {
+  b->ArgNames({"sample", "threads", "image"});
+  for (const int sample : {kMarble, kPotato}) {
+    for (const int image : {0, 1}) b->Args({sample, 2, image});
+  }
+}
+
+}  // namespace
+
+BENCHMARK(BM_PhotonTransport)->Apply(photon_transport_arguments)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PhotonTransport)
+    ->Apply(photon_transport_threaded_arguments)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+
+BENCHMARK_MAIN();
