@@ -1,0 +1,141 @@
+// `lucent fit`: profiles in, a material file out.
+#include <cmath>
+#include <iostream>
+#include <memory>
+
+#include "commands.h"
+#include "lucent/fit/fit.h"
+#include "lucent/fit/fit_plot.h"
+#include "lucent/materials/atomic_file.h"
+#include "lucent/materials/error.h"
+
+namespace lucent::cli {
+namespace {
+
+struct FitArguments {
+  std::vector<std::string> inputs;
+  std::string output;
+  std::string model = "auto";
+  std::string loss = "none";
+  std::string quality = "balanced";
+  std::string plot, report, name;
+  double exclude_radius_mm = -1;
+  double ior = 0;
+  bool fit_ior = false, relative = false, json = false, allow_unconverged = false;
+};
+
+fit::FitOptions to_options(const FitArguments& a) {
+  fit::FitOptions o;
+  if (a.model == "dipole") o.model = fit::FitModel::kDipole;
+  else if (a.model == "ddipole") o.model = fit::FitModel::kDirectionalDipole;
+  else if (a.model == "auto") o.model = fit::FitModel::kAuto;
+  else throw Error("--model: expected dipole, ddipole or auto, got '" + a.model + "'");
+  if (a.quality == "fast") o.quality = fit::Quality::kFast;
+  else if (a.quality == "balanced") o.quality = fit::Quality::kBalanced;
+  else if (a.quality == "accurate") o.quality = fit::Quality::kAccurate;
+  else throw Error("--quality: expected fast, balanced or accurate, got '" + a.quality + "'");
+  if (a.loss == "none") {
+    o.loss = fit::LossKind::kNone;
+  } else {
+    const auto colon = a.loss.find(':');
+    const std::string kind = a.loss.substr(0, colon);
+    if (kind == "huber") o.loss = fit::LossKind::kHuber;
+    else if (kind == "cauchy") o.loss = fit::LossKind::kCauchy;
+    else throw Error("--loss: expected none, huber:S or cauchy:S, got '" + a.loss + "'");
+    if (colon != std::string::npos) {
+      try {
+        o.loss_scale = std::stod(a.loss.substr(colon + 1));
+      } catch (const std::exception&) {
+        throw Error("--loss: the scale S in " + a.loss + " must be a number (in standard errors)");
+      }
+      if (!(o.loss_scale > 0)) throw Error("--loss: the scale S must be > 0 standard errors");
+    }
+  }
+  if (a.exclude_radius_mm >= 0) o.exclude_radius_mm = a.exclude_radius_mm;
+  if (a.ior != 0) {
+    if (!(a.ior > 0 && a.ior <= 4)) throw Error("--ior: expected a relative index in (0, 4]");
+    o.ior = a.ior;
+  }
+  o.fit_ior = a.fit_ior;
+  if (a.relative) o.relative = true;
+  o.allow_unconverged = a.allow_unconverged;
+  return o;
+}
+
+void run(const FitArguments& a) {
+  fit::FitOptions options = to_options(a);
+  std::vector<fit::ProfileData> data;
+  for (const std::string& input : a.inputs) {
+    data.push_back(fit::load_profile_data(input));
+    const bool csv = input.size() > 4 && input.substr(input.size() - 4) == ".csv";
+    if (csv && !options.ior && !options.fit_ior) {
+      throw Error("--ior: required with a CSV profile (" + input + "), which carries no index");
+    }
+  }
+  const fit::FitResult result = fit::fit_profiles(data, options);
+  std::string name = a.name;
+  if (name.empty()) name = std::filesystem::path(a.output).stem().string();
+  const materials::Material material = fit::fitted_material(result, data, options, name);
+  // Everything is computed before anything is written; each file is written atomically.
+  if (!a.plot.empty()) fit::write_fit_plot(a.plot, result, data.front());
+  if (!a.report.empty()) {
+    write_file_atomically(a.report, fit::fit_report(result, data, options).dump(2) + "\n");
+  }
+  materials::write_material(a.output, material);
+
+  const fit::ModelFit& f = result.chosen;
+  if (a.json) {
+    nlohmann::json j = fit::fit_report(result, data, options);
+    j["output"] = a.output;
+    std::cout << j.dump(2) << '\n';
+    return;
+  }
+  const char* names[3] = {"R", "G", "B"};
+  std::cout << "fitted " << (f.model == fit::FitModel::kDipole ? "standard dipole" : "directional dipole")
+            << " (" << result.reason << ")\n";
+  for (int c = 0; c < 3; ++c) {
+    if (f.channels[c].samples == 0) continue;
+    std::cout << "  " << names[c] << ": sigma_a = " << f.channels[c].sigma_a << " +- "
+              << f.channels[c].sd_sigma_a << " /mm, sigma_s' = " << f.channels[c].sigma_s_reduced
+              << " +- " << f.channels[c].sd_sigma_s_reduced << " /mm (" << f.channels[c].samples
+              << " samples, rms " << f.channels[c].residual_rms << " SE)\n";
+  }
+  for (const std::string& note : result.notes) std::cout << "  note: " << note << '\n';
+  std::cout << "wrote " << a.output << '\n';
+}
+
+}  // namespace
+
+void register_fit_command(CLI::App& app) {
+  auto args = std::make_shared<FitArguments>();
+  CLI::App* cmd = app.add_subcommand(
+      "fit",
+      "Fit the standard or directional dipole to measured profiles (lucent-profile JSON from lucent "
+      "acquire, or CSV with r_mm and R or R_r,R_g,R_b per mm^2 and optional se columns) and write a "
+      "material file. Several profiles of one material are fitted jointly.");
+  cmd->add_option("inputs", args->inputs, "profile files (.json or .csv)")->required();
+  cmd->add_option("-o,--output", args->output, "material file to write (.json)")->required();
+  cmd->add_option("--model", args->model, "dipole, ddipole or auto (simplest the data does not reject)")
+      ->capture_default_str();
+  cmd->add_option("--exclude-radius-mm", args->exclude_radius_mm,
+                  "leave out samples closer to the entry point than this, mm (default: one transport "
+                  "mean free path, estimated)");
+  cmd->add_option("--ior", args->ior, "relative index of refraction of the sample (required with CSV)");
+  cmd->add_flag("--fit-ior", args->fit_ior, "fit the index too (one for all channels)");
+  cmd->add_flag("--relative", args->relative,
+                "fit a global scale (automatic when the profile says it is relative)");
+  cmd->add_option("--loss", args->loss, "none, huber:S or cauchy:S (S in standard errors)")
+      ->capture_default_str();
+  cmd->add_option("--quality", args->quality,
+                  "fast, balanced or accurate: footprint quadrature order, samples used, tolerances")
+      ->capture_default_str();
+  cmd->add_option("--plot", args->plot, "write the fit plot (PNG)");
+  cmd->add_option("--report", args->report, "write everything per channel (JSON)");
+  cmd->add_option("--name", args->name, "material name (default: the output file's stem)");
+  cmd->add_flag("--allow-unconverged", args->allow_unconverged,
+                "write the best values even when the solver did not converge");
+  cmd->add_flag("--json", args->json, "print the report as JSON on stdout");
+  cmd->callback([args] { run(*args); });
+}
+
+}  // namespace lucent::cli

@@ -1,0 +1,49 @@
+// What a fit consumes: radial bins (normal incidence) and/or 2D samples (oblique incidence) of pi L / P
+// per mm^2, per channel, with standard errors, and the geometry they were taken in.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace lucent::fit {
+
+struct RadialBins {
+  std::vector<double> r_mm;        ///< representative radius (mean over the bin's pixels), mm
+  std::vector<double> r_inner_mm;  ///< annulus, mm (equal to r_mm when only points are known)
+  std::vector<double> r_outer_mm;
+  std::array<std::vector<double>, 3> value;           ///< per mm^2 (or relative), per channel
+  std::array<std::vector<double>, 3> standard_error;  ///< same units; > 0
+  std::size_t size() const { return r_mm.size(); }
+};
+
+struct Samples2d {
+  std::vector<double> x_mm, y_mm;  ///< from the entry point, surface coordinates, mm
+  double pixel_mm = 0;             ///< footprint side, mm (0: points)
+  std::array<std::vector<double>, 3> value;
+  std::array<std::vector<double>, 3> standard_error;
+  std::size_t size() const { return x_mm.size(); }
+};
+
+/// One measured profile (one capture).
+struct ProfileData {
+  std::string source;                ///< file it came from
+  bool calibrated = true;            ///< false: values known up to one scale
+  std::optional<double> eta;         ///< relative index when known (CSV: --ior)
+  double incidence_polar_deg = 0;
+  double incidence_azimuth_deg = 0;  ///< direction of travel from +x
+  double view_deg = 0;
+  RadialBins radial;
+  std::optional<Samples2d> samples_2d;
+  std::array<bool, 3> channels{true, true, true};  ///< which channels carry data
+};
+
+/// Reads a `lucent-profile` JSON (from lucent acquire) or a CSV with header `r_mm` and value columns
+/// `R` or `R_r,R_g,R_b`, optional `se` / `se_r,se_g,se_b` and `r_inner_mm,r_outer_mm`. CSV values are
+/// per mm^2 per unit power entering; without se columns a 5% relative error is assumed (and said in
+/// the report). Throws lucent::Error with one line naming the file, line or field.
+ProfileData load_profile_data(const std::filesystem::path& path);
+
+}  // namespace lucent::fit

@@ -1,0 +1,153 @@
+#include "lucent/fit/fit_data.h"
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "lucent/acquire/profile.h"
+#include "lucent/materials/error.h"
+
+namespace lucent::fit {
+namespace {
+
+std::string trim(std::string s) {
+  const auto a = s.find_first_not_of(" \t\r\n");
+  if (a == std::string::npos) return {};
+  return s.substr(a, s.find_last_not_of(" \t\r\n") - a + 1);
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream in(line);
+  std::string field;
+  while (std::getline(in, field, ',')) out.push_back(trim(field));
+  if (!line.empty() && line.back() == ',') out.emplace_back();
+  return out;
+}
+
+ProfileData load_csv(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  const std::string source = path.string();
+  if (!in) throw Error(source + ": cannot open the profile");
+  std::string line;
+  int line_number = 0;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (!trim(line).empty() && trim(line)[0] != '#') break;
+  }
+  const std::vector<std::string> header = split(trim(line));
+  std::map<std::string, int> column;
+  for (std::size_t i = 0; i < header.size(); ++i) column[header[i]] = int(i);
+  const auto has = [&](const std::string& name) { return column.count(name) > 0; };
+  if (!has("r_mm")) {
+    throw Error(source + ": line " + std::to_string(line_number) +
+                ": expected a header with r_mm and R (or R_r,R_g,R_b) columns");
+  }
+  ProfileData d;
+  d.source = source;
+  std::array<int, 3> value_col{-1, -1, -1}, se_col{-1, -1, -1};
+  const char* suffix[3] = {"_r", "_g", "_b"};
+  if (has("R")) {
+    value_col = {column["R"], column["R"], column["R"]};
+    if (has("se")) se_col = {column["se"], column["se"], column["se"]};
+    d.channels = {true, false, false};
+  } else {
+    for (int c = 0; c < 3; ++c) {
+      const std::string name = std::string("R") + suffix[c];
+      if (has(name)) value_col[c] = column[name];
+      if (has(std::string("se") + suffix[c])) se_col[c] = column[std::string("se") + suffix[c]];
+      d.channels[c] = value_col[c] >= 0;
+    }
+    if (!d.channels[0] && !d.channels[1] && !d.channels[2]) {
+      throw Error(source + ": line " + std::to_string(line_number) +
+                  ": expected value columns R or R_r,R_g,R_b beside r_mm");
+    }
+  }
+  const int inner = has("r_inner_mm") ? column["r_inner_mm"] : -1;
+  const int outer = has("r_outer_mm") ? column["r_outer_mm"] : -1;
+  bool assumed_errors = false;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (trim(line).empty() || trim(line)[0] == '#') continue;
+    const std::vector<std::string> f = split(trim(line));
+    const std::string where = source + ": line " + std::to_string(line_number) + ": ";
+    if (f.size() != header.size()) {
+      throw Error(where + "expected " + std::to_string(header.size()) + " fields, found " +
+                  std::to_string(f.size()));
+    }
+    const auto number = [&](int col) {
+      double v = 0;
+      const std::string& t = f[col];
+      const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+      if (ec != std::errc() || end != t.data() + t.size() || !std::isfinite(v)) {
+        throw Error(where + "column " + header[col] + ": expected a finite number, got '" + t + "'");
+      }
+      return v;
+    };
+    const double r = number(column["r_mm"]);
+    if (r < 0) throw Error(where + "r_mm must be >= 0");
+    d.radial.r_mm.push_back(r);
+    d.radial.r_inner_mm.push_back(inner >= 0 ? number(inner) : r);
+    d.radial.r_outer_mm.push_back(outer >= 0 ? number(outer) : r);
+    for (int c = 0; c < 3; ++c) {
+      const double v = value_col[c] >= 0 ? number(value_col[c]) : 0.0;
+      double se = 0;
+      if (se_col[c] >= 0) {
+        se = number(se_col[c]);
+        if (!(se > 0)) throw Error(where + "column " + header[se_col[c]] + ": expected a standard error > 0");
+      } else {
+        se = 0.05 * std::abs(v);  // documented assumption: 5% relative error
+        assumed_errors = true;
+      }
+      d.radial.value[c].push_back(v);
+      d.radial.standard_error[c].push_back(se);
+    }
+  }
+  (void)assumed_errors;
+  if (d.radial.size() == 0) throw Error(source + ": the profile is empty (a header and no rows)");
+  return d;
+}
+
+ProfileData load_json(const std::filesystem::path& path) {
+  const acquire::Profile p = acquire::read_profile(path);
+  ProfileData d;
+  d.source = path.string();
+  d.calibrated = p.calibrated;
+  // TODO(ior): d.eta = p.ior once profiles carry the index
+  d.incidence_polar_deg = p.incidence_polar_deg;
+  d.incidence_azimuth_deg = p.incidence_azimuth_deg;
+  d.view_deg = p.view_deg;
+  d.radial.r_mm = p.radial.r_mm;
+  d.radial.r_inner_mm = p.radial.r_inner_mm;
+  d.radial.r_outer_mm = p.radial.r_outer_mm;
+  for (int c = 0; c < 3; ++c) {
+    d.radial.value[c] = p.radial.value[c];
+    d.radial.standard_error[c] = p.radial.standard_error[c];
+  }
+  if (p.samples_2d) {
+    Samples2d s;
+    s.x_mm = p.samples_2d->x_mm;
+    s.y_mm = p.samples_2d->y_mm;
+    s.pixel_mm = p.pixel_pitch_mm;
+    for (int c = 0; c < 3; ++c) {
+      s.value[c] = p.samples_2d->value[c];
+      s.standard_error[c] = p.samples_2d->standard_error[c];
+    }
+    d.samples_2d = s;
+  }
+  return d;
+}
+
+}  // namespace
+
+ProfileData load_profile_data(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+  if (ext == ".csv") return load_csv(path);
+  if (ext == ".json") return load_json(path);
+  throw Error(path.string() + ": expected a lucent-profile .json (from lucent acquire) or a .csv");
+}
+
+}  // namespace lucent::fit

@@ -1,0 +1,173 @@
+#include "lucent/fit/fit.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "lucent/materials/dipole.h"
+#include "lucent/materials/directional_dipole.h"
+#include "lucent/materials/error.h"
+#include "lucent/materials/fresnel.h"
+
+namespace lucent::fit {
+namespace {
+
+using materials::Medium;
+
+// A radial profile made by the model itself (point samples, no noise): what the camera would record
+// at normal incidence, pi L / P = F_t F_t R_d (dipole) or F_t F_t pi S_d (ddipole).
+ProfileData model_profile(const materials::Material& m, FitModel model, int bins = 150) {
+  ProfileData d;
+  d.source = "model:" + m.name;
+  d.eta = m.ior;
+  const double ft = materials::fresnel_transmittance(1.0, m.ior);
+  double r_min = INFINITY, r_max = 0;
+  for (int c = 0; c < 3; ++c) {
+    const auto coeffs = materials::derive_coefficients(m.medium(c));
+    d.channels[c] = coeffs.scatters();
+    if (!coeffs.scatters()) continue;
+    r_min = std::min(r_min, 0.2 / coeffs.sigma_t_reduced);
+    r_max = std::max(r_max, std::min(8.0 / coeffs.sigma_tr, 400.0 / coeffs.sigma_t_reduced));
+  }
+  for (int i = 0; i < bins; ++i) {
+    const double r = r_min * std::pow(r_max / r_min, double(i) / (bins - 1));
+    d.radial.r_mm.push_back(r);
+    d.radial.r_inner_mm.push_back(r);
+    d.radial.r_outer_mm.push_back(r);
+    for (int c = 0; c < 3; ++c) {
+      const Medium<double> medium = Medium<double>::from_reduced(m.sigma_a[c], m.sigma_s_reduced[c], m.ior);
+      double v = 0;
+      if (d.channels[c]) {
+        if (model == FitModel::kDipole) {
+          v = materials::StandardDipole<double>(medium).R_d(r);
+        } else {
+          const materials::Vec3<double> up(0, 0, 1);
+          v = std::numbers::pi * materials::DirectionalDipole<double>(medium).S_d(
+                                     materials::Vec3<double>::Zero(), up, up, {r, 0, 0}, up);
+        }
+      }
+      d.radial.value[c].push_back(ft * ft * v);
+      d.radial.standard_error[c].push_back(0.01 * ft * ft * v + 1e-300);
+    }
+  }
+  return d;
+}
+
+class ExactRecovery : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(ExactRecovery, BothModelsFromStartValuesTenTimesOff) {
+  const materials::Material m = materials::load_material(GetParam());
+  for (FitModel model : {FitModel::kDipole, FitModel::kDirectionalDipole}) {
+    FitOptions o;
+    o.model = model;
+    o.exclude_radius_mm = 0;
+    o.quality = Quality::kAccurate;
+    std::array<std::array<double, 2>, 3> start{};
+    for (int c = 0; c < 3; ++c) start[c] = {10 * m.sigma_a[c], 10 * m.sigma_s_reduced[c]};
+    o.start = start;
+    const FitResult r = fit_profiles({model_profile(m, model)}, o);
+    EXPECT_TRUE(r.chosen.converged) << r.chosen.message;
+    for (int c = 0; c < 3; ++c) {
+      if (!materials::derive_coefficients(m.medium(c)).scatters()) continue;
+      EXPECT_NEAR(r.chosen.channels[c].sigma_a, m.sigma_a[c], 1e-4 * m.sigma_a[c])
+          << GetParam() << " channel " << c << " model " << int(model);
+      EXPECT_NEAR(r.chosen.channels[c].sigma_s_reduced, m.sigma_s_reduced[c], 1e-4 * m.sigma_s_reduced[c])
+          << GetParam() << " channel " << c << " model " << int(model);
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Bundled, ExactRecovery,
+                         ::testing::ValuesIn(materials::library_material_names()));
+
+TEST(Fit, AutoKeepsTheDipoleForDipoleDataAndTakesTheDdipoleForDdipoleData) {
+  const materials::Material m = materials::load_material("potato");
+  FitOptions o;
+  o.exclude_radius_mm = 0;
+  const FitResult from_dipole = fit_profiles({model_profile(m, FitModel::kDipole)}, o);
+  EXPECT_EQ(from_dipole.chosen.model, FitModel::kDipole) << from_dipole.reason;
+  const FitResult from_ddipole = fit_profiles({model_profile(m, FitModel::kDirectionalDipole)}, o);
+  EXPECT_EQ(from_ddipole.chosen.model, FitModel::kDirectionalDipole) << from_ddipole.reason;
+  EXPECT_EQ(from_ddipole.candidates.size(), 2u);
+}
+
+TEST(Fit, RelativeProfileRecoversTheScale) {
+  const materials::Material m = materials::load_material("skin1");
+  ProfileData d = model_profile(m, FitModel::kDipole);
+  for (int c = 0; c < 3; ++c) {
+    for (double& v : d.radial.value[c]) v *= 37.0;
+    for (double& v : d.radial.standard_error[c]) v *= 37.0;
+  }
+  d.calibrated = false;
+  FitOptions o;
+  o.model = FitModel::kDipole;
+  o.exclude_radius_mm = 0;
+  const FitResult r = fit_profiles({d}, o);
+  EXPECT_NEAR(r.chosen.scale, 37.0, 1e-3 * 37.0);
+  EXPECT_NEAR(r.chosen.channels[1].sigma_a, m.sigma_a[1], 1e-3 * m.sigma_a[1]);
+}
+
+TEST(Fit, UncertaintyIsReportedAndFiniteForAGoodFit) {
+  const FitResult r = fit_profiles({model_profile(materials::load_material("marble"), FitModel::kDipole)},
+                                   FitOptions{.model = FitModel::kDipole});
+  for (const ChannelFit& c : r.chosen.channels) {
+    EXPECT_GT(c.sd_sigma_a, 0.0);
+    EXPECT_GT(c.sd_sigma_s_reduced, 0.0);
+    EXPECT_LT(c.sd_sigma_a, c.sigma_a);
+    EXPECT_TRUE(std::abs(c.correlation) <= 1.0);
+  }
+  EXPECT_TRUE(r.chosen.undetermined.empty());
+}
+
+TEST(Fit, ScaleAndAlbedoTogetherAreUndeterminedInTheFarFieldOnly) {
+  // Far-field samples of a relative profile fix sigma_tr but not sigma_a and sigma_s' apart from the
+  // scale: the fit must say so rather than crash or report tiny errors.
+  const materials::Material m = materials::load_material("marble");
+  ProfileData d = model_profile(m, FitModel::kDipole);
+  d.calibrated = false;
+  d.channels = {true, false, false};
+  FitOptions o;
+  o.model = FitModel::kDipole;
+  o.exclude_radius_mm = 60.0;  // only r > 60 mm: pure exponential tail
+  o.allow_unconverged = true;
+  const FitResult r = fit_profiles({d}, o);
+  EXPECT_FALSE(r.chosen.undetermined.empty());
+}
+
+TEST(Fit, BadInputs) {
+  const materials::Material m = materials::load_material("marble");
+  EXPECT_THROW(fit_profiles({}, FitOptions{}), Error);
+  ProfileData empty;
+  empty.source = "empty.csv";
+  empty.eta = 1.5;
+  try {
+    fit_profiles({empty}, FitOptions{});
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("empty"), std::string::npos) << e.what();
+  }
+  ProfileData few = model_profile(m, FitModel::kDipole, 150);
+  FitOptions o;
+  o.exclude_radius_mm = 1e6;  // nothing left
+  try {
+    fit_profiles({few}, o);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("usable samples"), std::string::npos) << e.what();
+  }
+  ProfileData nan = model_profile(m, FitModel::kDipole);
+  nan.radial.value[1][10] = std::nan("");
+  EXPECT_THROW(fit_profiles({nan}, FitOptions{}), Error);
+  ProfileData no_eta = model_profile(m, FitModel::kDipole);
+  no_eta.eta.reset();
+  try {
+    fit_profiles({no_eta}, FitOptions{});
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--ior"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace lucent::fit
