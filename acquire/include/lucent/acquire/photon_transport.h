@@ -1,11 +1,13 @@
 // Monte Carlo photon transport in a homogeneous slab: the ground truth behind `lucent simulate`
-// (DESIGN §5). A pencil beam of unit power enters a flat sample at the origin; per colour channel the
-// simulation records the specular, diffuse-reflected, transmitted and absorbed power, the radial
-// exitance R(r), and an image of the radiance leaving toward an orthographic camera (next-event
-// estimate at every scattering event). Deterministic for a seed, whatever the number of threads.
+// (DESIGN §5). A pencil beam of unit power enters a flat sample at the origin; per colour channel
+// the simulation records the specular, diffuse-reflected, transmitted and absorbed power, the
+// radial exitance R(r), and an image of the radiance leaving toward an orthographic camera
+// (next-event estimate at every scattering event). Deterministic for a seed, whatever the number of
+// threads.
 //
-// Geometry: the sample fills z < 0 below the surface z = 0 (and ends at z = -thickness_mm when that is
-// finite, with the same outside medium below). Lengths in mm, coefficients in mm^-1, angles in degrees.
+// Geometry: the sample fills z < 0 below the surface z = 0 (and ends at z = -thickness_mm when that
+// is finite, with the same outside medium below). Lengths in mm, coefficients in mm^-1, angles in
+// degrees.
 #pragma once
 
 #include <array>
@@ -19,7 +21,8 @@
 
 namespace lucent::acquire {
 
-/// How a packet that reaches the surface from inside is split between escape and internal reflection.
+/// How a packet that reaches the surface from inside is split between escape and internal
+/// reflection.
 enum class BoundaryScoring {
   /// Reflect with probability R (Fresnel), escape with the whole weight otherwise. The default: for
   /// equal variance of every tally it is faster than splitting (see photon_transport.cpp).
@@ -28,11 +31,11 @@ enum class BoundaryScoring {
   kSplit,
 };
 
-/// Everything one simulation needs. Defaults give a 1e6-photon run of a semi-infinite slab lit along
-/// the normal and seen along the normal.
+/// Everything one simulation needs. Defaults give a 1e6-photon run of a semi-infinite slab lit
+/// along the normal and seen along the normal.
 struct PhotonTransportOptions {
-  /// Per channel (R, G, B): sigma_a, sigma_s (mm^-1), Henyey-Greenstein g and eta = n_sample / n_air.
-  /// A material known only through sigma_s' gives g = 0 (Material::medium()).
+  /// Per channel (R, G, B): sigma_a, sigma_s (mm^-1), Henyey-Greenstein g and eta = n_sample /
+  /// n_air. A material known only through sigma_s' gives g = 0 (Material::medium()).
   std::array<materials::Medium<double>, 3> media{};
   /// Slab thickness, mm; infinity for a semi-infinite sample.
   double thickness_mm = std::numeric_limits<double>::infinity();
@@ -55,8 +58,8 @@ struct PhotonTransportOptions {
   bool image = true;
   /// Image width and height, pixels, in [1, 16384].
   int size = 128;
-  /// Pixel pitch on the sample surface, mm (> 0). The grid is centred on the entry point: pixel (i, j)
-  /// covers x = (i + 0.5 - size/2) pixel_mm, y = (j + 0.5 - size/2) pixel_mm (+- half a pixel).
+  /// Pixel pitch on the sample surface, mm (> 0). The grid is centred on the entry point: pixel (i,
+  /// j) covers x = (i + 0.5 - size/2) pixel_mm, y = (j + 0.5 - size/2) pixel_mm (+- half a pixel).
   double pixel_mm = 0.1;
   /// Polar angle of the direction toward the camera from the surface normal, degrees, in [0, 90).
   double view_deg = 0;
@@ -85,8 +88,9 @@ struct ExitanceBin {
   double r_centre_mm = 0;  ///< area-weighted mean radius, 2/3 (r_o^3 - r_i^3) / (r_o^2 - r_i^2)
 };
 
-/// The annuli used for max_radius_mm: 0.01 mm wide up to 0.5 mm, then each 5% wider than the one before,
-/// the last one ending exactly at max_radius_mm (a sliver narrower than half a bin joins its neighbour).
+/// The annuli used for max_radius_mm: 0.01 mm wide up to 0.5 mm, then each 5% wider than the one
+/// before, the last one ending exactly at max_radius_mm (a sliver narrower than half a bin joins
+/// its neighbour).
 std::vector<ExitanceBin> exitance_bins(double max_radius_mm);
 
 /// The results of one channel; all per unit incident power.
@@ -106,8 +110,8 @@ struct ChannelTransportResult {
   /// Radial exitance R(r), mm^-2, one per exitance_bins(max_radius_mm) entry.
   std::vector<Estimate> exitance;
   /// Radiance toward the camera, mm^-2 sr^-1, size * size values, pixel (i, j) at [j * size + i]
-  /// (rows along +y). Empty when options.image is false; all zero when no direction inside the sample
-  /// refracts toward the camera (eta < 1 and view_deg beyond the critical angle).
+  /// (rows along +y). Empty when options.image is false; all zero when no direction inside the
+  /// sample refracts toward the camera (eta < 1 and view_deg beyond the critical angle).
   std::vector<double> image;
   /// Standard error of each image value, mm^-2 sr^-1 (per-photon sums of squares).
   std::vector<double> image_standard_error;
@@ -115,8 +119,8 @@ struct ChannelTransportResult {
   Estimate image_integral;
   /// Mean number of interactions (collisions) per photon: the cost driver.
   double mean_interactions = 0;
-  /// Photons stopped after kMaxInteractionsPerPhoton interactions (only for albedo within ~1e-6 of 1
-  /// in a thick sample); their remaining weight is booked as absorbed.
+  /// Photons stopped after kMaxInteractionsPerPhoton interactions (only for albedo within ~1e-6 of
+  /// 1 in a thick sample); their remaining weight is booked as absorbed.
   std::uint64_t photons_truncated = 0;
 };
 
@@ -124,16 +128,17 @@ struct ChannelTransportResult {
 inline constexpr std::uint64_t kMaxInteractionsPerPhoton = 10'000'000;
 
 struct PhotonTransportResult {
-  PhotonTransportOptions options;        ///< as given (threads as given, 0 included)
-  std::vector<ExitanceBin> bins;         ///< exitance_bins(options.max_radius_mm)
+  PhotonTransportOptions options;  ///< as given (threads as given, 0 included)
+  std::vector<ExitanceBin> bins;   ///< exitance_bins(options.max_radius_mm)
   std::array<ChannelTransportResult, 3> channels;
-  std::uint64_t seed = 0;                ///< options.seed
-  int threads_used = 0;                  ///< worker threads actually started
-  double wall_seconds = 0;               ///< elapsed time of the whole simulation
+  std::uint64_t seed = 0;   ///< options.seed
+  int threads_used = 0;     ///< worker threads actually started
+  double wall_seconds = 0;  ///< elapsed time of the whole simulation
 };
 
-/// Called after each batch is merged (from one thread at a time), with photons merged so far and the
-/// total over all selected channels. An exception thrown here stops the simulation and propagates.
+/// Called after each batch is merged (from one thread at a time), with photons merged so far and
+/// the total over all selected channels. An exception thrown here stops the simulation and
+/// propagates.
 using PhotonTransportProgress =
     std::function<void(std::uint64_t photons_done, std::uint64_t photons_total)>;
 
@@ -146,8 +151,8 @@ PhotonTransportResult simulate_photon_transport(const PhotonTransportOptions& op
 
 /// The radial exitance as CSV: `#` comment lines with key=value tokens (format, photons, seed, the
 /// geometry, the four totals and their standard errors as R,G,B), then the header
-/// `r_mm,R_r,R_g,R_b,se_r,se_g,se_b` and one row per bin (r_mm = area-weighted centre, values mm^-2),
-/// 17 significant digits. Channels not simulated print `nan`.
+/// `r_mm,R_r,R_g,R_b,se_r,se_g,se_b` and one row per bin (r_mm = area-weighted centre, values
+/// mm^-2), 17 significant digits. Channels not simulated leave their fields empty.
 std::string exitance_csv(const PhotonTransportResult& result);
 
 }  // namespace lucent::acquire
