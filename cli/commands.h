@@ -8,5 +8,7 @@ namespace lucent::cli {
 
 void register_profile_command(CLI::App& app);
 void register_simulate_command(CLI::App& app);
+void register_acquire_command(CLI::App& app);
+void register_fit_command(CLI::App& app);
 
 }  // namespace lucent::cli

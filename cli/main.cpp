@@ -14,6 +14,8 @@ int main(int argc, char** argv) {
   app.fallthrough(false);
   lucent::cli::register_profile_command(app);
   lucent::cli::register_simulate_command(app);
+  lucent::cli::register_acquire_command(app);
+  lucent::cli::register_fit_command(app);
 
   try {
     app.parse(argc, argv);

@@ -17,6 +17,7 @@ struct SimulateArguments {
   std::string output;
   std::string exposures = "1/1000,1/250,1/60,1/15,1/4";
   std::string response = "srgb";
+  std::string source = "montecarlo";
   std::string exitance_csv;
   bool no_white = false;
   bool no_dark = false;
@@ -64,6 +65,10 @@ void run(SimulateArguments& args) {
   else if (args.response == "linear") o.camera.response = acquire::Response::kLinear;
   else throw Error("--response: expected 'srgb' or 'linear', got '" + args.response + "'");
   o.camera.exposures_s = parse_exposures(args.exposures);
+  if (args.source == "montecarlo") o.source = acquire::RadianceSource::kMonteCarlo;
+  else if (args.source == "dipole") o.source = acquire::RadianceSource::kDipole;
+  else if (args.source == "ddipole") o.source = acquire::RadianceSource::kDirectionalDipole;
+  else throw Error("--source: expected montecarlo, dipole or ddipole, got '" + args.source + "'");
   o.camera.noise = !args.no_noise;
   o.white_reference = !args.no_white;
   o.dark_frame = !args.no_dark;
@@ -120,6 +125,9 @@ void register_simulate_command(CLI::App& app) {
       "acquire, the bracket PNGs, truth.json and truth_radiance.exr (mm^-2 sr^-1 per unit power).");
   cmd->add_option("--material", args->material, "bundled material name or material file")->required();
   cmd->add_option("-o,--output", args->output, "output folder (created; written atomically)")->required();
+  cmd->add_option("--source", args->source,
+                  "exit radiance from montecarlo (photon transport), or from the dipole / ddipole "
+                  "model (for round trips of lucent fit)")->capture_default_str();
   cmd->add_option("--photons", o.transport.photons, "photons per colour channel")->capture_default_str();
   cmd->add_option("--seed", o.transport.seed, "random seed (results identical for any --threads)")
       ->capture_default_str();

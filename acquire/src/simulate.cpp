@@ -5,6 +5,9 @@
 #include <sstream>
 
 #include "lucent/acquire/image_io.h"
+#include "lucent/materials/dipole.h"
+#include "lucent/materials/directional_dipole.h"
+#include "lucent/materials/fresnel.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
 #include "lucent/version.h"
@@ -81,6 +84,42 @@ std::string bracket_name(const char* stem, std::size_t k) {
 
 }  // namespace
 
+ImageRgb model_radiance(const materials::Material& material, RadianceSource source,
+                        const PhotonTransportOptions& g) {
+  constexpr double kDegree = std::numbers::pi / 180;
+  const double theta = g.incidence_deg * kDegree, phi = g.azimuth_deg * kDegree;
+  const materials::Vec3<double> w_i(-std::sin(theta) * std::cos(phi), -std::sin(theta) * std::sin(phi),
+                                    std::cos(theta));
+  const materials::Vec3<double> up(0, 0, 1);
+  ImageRgb image(g.size, g.size);
+  for (int c = 0; c < 3; ++c) {
+    const materials::Medium<double> medium = material.medium(c);
+    const double fresnel = materials::fresnel_transmittance(std::cos(theta), medium.eta) *
+                           materials::fresnel_transmittance(std::cos(g.view_deg * kDegree), medium.eta);
+    const materials::StandardDipole<double> dipole(medium);
+    const materials::DirectionalDipole<double> dd(medium);
+    const auto S = [&](double x, double y) {
+      if (source == RadianceSource::kDipole) return dipole.R_d(std::hypot(x, y)) / std::numbers::pi;
+      return dd.S_d(materials::Vec3<double>::Zero(), up, w_i, {x, y, 0.0}, up);
+    };
+    for (int j = 0; j < g.size; ++j) {
+      for (int i = 0; i < g.size; ++i) {
+        const double x0 = (i - g.size / 2.0) * g.pixel_mm, y0 = (j - g.size / 2.0) * g.pixel_mm;
+        // The profile is steepest at the entry point: more points in the pixels around it.
+        const bool centre = std::abs(x0 + 0.5 * g.pixel_mm) < 1.5 * g.pixel_mm &&
+                            std::abs(y0 + 0.5 * g.pixel_mm) < 1.5 * g.pixel_mm;
+        const int n = centre ? 16 : 4;
+        double sum = 0;
+        for (int a = 0; a < n; ++a) {
+          for (int b = 0; b < n; ++b) sum += S(x0 + (a + 0.5) / n * g.pixel_mm, y0 + (b + 0.5) / n * g.pixel_mm);
+        }
+        image.at(i, j, c) = float(fresnel * sum / (n * n));
+      }
+    }
+  }
+  return image;
+}
+
 ImageRgb white_reference_radiance(int size, double pixel_mm, double rho, double sigma_mm) {
   ImageRgb image(size, size);
   // The spot sits where the beam enters: the centre of the grid (x = y = 0 mm).
@@ -119,30 +158,44 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
   AtomicOutputDir out(out_dir);  // checks the folder can be made before the long simulation
 
   SimulateSummary summary;
-  summary.transport = simulate_photon_transport(transport, progress);
+  const bool monte_carlo = options.source == RadianceSource::kMonteCarlo;
+  if (monte_carlo) {
+    summary.transport = simulate_photon_transport(transport, progress);
+  } else {
+    if (options.profile_only) throw Error("--profile-only: needs the Monte Carlo source");
+    summary.transport.options = transport;
+  }
   const PhotonTransportResult& result = summary.transport;
 
   json truth = {{"format", "lucent-simulation-truth"},
                 {"version", 1},
                 {"material", materials::material_to_json(options.material)},
+                {"source", monte_carlo ? "montecarlo"
+                           : options.source == RadianceSource::kDipole ? "dipole" : "ddipole"},
                 {"transport", transport_to_json(transport)},
-                {"totals", totals_to_json(result)},
-                {"mean_interactions", json::array()},
-                {"wall_seconds", result.wall_seconds},
-                {"threads_used", result.threads_used},
                 {"tool", std::string("lucent simulate ") + kVersion}};
-  for (const auto& ch : result.channels) truth["mean_interactions"].push_back(ch.mean_interactions);
+  if (monte_carlo) {
+    truth["totals"] = totals_to_json(result);
+    truth["mean_interactions"] = json::array();
+    for (const auto& ch : result.channels) truth["mean_interactions"].push_back(ch.mean_interactions);
+    truth["wall_seconds"] = result.wall_seconds;
+    truth["threads_used"] = result.threads_used;
+  }
 
   if (!options.profile_only) {
-    const ImageRgb radiance = to_image(result, false);
+    const ImageRgb radiance = monte_carlo ? to_image(result, false)
+                                          : model_radiance(options.material, options.source, transport);
     const double pixel_area = transport.pixel_mm * transport.pixel_mm;
     const double scale = camera_scale(options.camera, peak(radiance));
     summary.camera_scale = scale;
     write_exr(out.temporary() / "truth_radiance.exr", radiance,
               {{"units", "radiance per unit incident power, mm^-2 sr^-1"}});
-    write_exr(out.temporary() / "truth_radiance_se.exr", to_image(result, true),
-              {{"units", "standard error of truth_radiance, mm^-2 sr^-1"}});
-    summary.files = {"truth_radiance.exr", "truth_radiance_se.exr"};
+    summary.files = {"truth_radiance.exr"};
+    if (monte_carlo) {
+      write_exr(out.temporary() / "truth_radiance_se.exr", to_image(result, true),
+                {{"units", "standard error of truth_radiance, mm^-2 sr^-1"}});
+      summary.files.push_back("truth_radiance_se.exr");
+    }
 
     Capture capture;
     capture.pixel_pitch_mm = transport.pixel_mm;
@@ -199,7 +252,7 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
   write_file_atomically(out.temporary() / "truth.json", truth.dump(2) + "\n");
   summary.files.push_back("truth.json");
   out.commit();
-  if (options.exitance_csv) write_file_atomically(*options.exitance_csv, exitance_csv(result));
+  if (options.exitance_csv && monte_carlo) write_file_atomically(*options.exitance_csv, exitance_csv(result));
   return summary;
 }
 

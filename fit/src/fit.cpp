@@ -41,7 +41,7 @@ struct Observations {
   CaptureGeometry geometry;
   std::vector<double> r, r0, r1;   // radial
   std::vector<double> x, y;        // 2D
-  double pixel = 0;                // 2D footprint side
+  double pixel = 0;                // footprint side of the pixels behind the samples, mm
   std::vector<double> log_value;   // log of the measurement
   std::vector<double> inv_rel_se;  // value / standard error: weights the log-ratio
 };
@@ -98,31 +98,46 @@ struct ChannelResiduals {
   }
 };
 
-// The standard dipole on radial bins with a hand-written Jacobian (scale and eta held).
+// The standard dipole with a hand-written Jacobian (scale and eta held): annuli, or pixel footprints.
 class DipoleRadialCost : public ceres::CostFunction {
  public:
-  DipoleRadialCost(const Observations* obs, GaussLegendre gl, const double* log_scale, const double* eta)
-      : obs_(obs), gl_(gl), log_scale_(log_scale), eta_(eta) {
+  // Parameter blocks: {log sigma_a, log sigma_s'} and {log scale}.
+  DipoleRadialCost(const Observations* obs, GaussLegendre gl, const double* eta)
+      : obs_(obs), gl_(gl), eta_(eta) {
     set_num_residuals(int(obs->log_value.size()));
     mutable_parameter_block_sizes()->push_back(2);
+    mutable_parameter_block_sizes()->push_back(1);
   }
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     const double* ab = parameters[0];
     const detail::DipoleGradientModel model(std::exp(ab[0]), std::exp(ab[1]), *eta_);
-    const double log_front = *log_scale_ + std::log(detail::fresnel_factor(obs_->geometry, *eta_));
+    const double log_front = parameters[1][0] + std::log(detail::fresnel_factor(obs_->geometry, *eta_));
     for (std::size_t i = 0; i < obs_->log_value.size(); ++i) {
       detail::DipoleGradient sum;
-      const double r0 = obs_->r0[i], r1 = obs_->r1[i];
-      if (!(r1 > r0)) {
-        sum = model.at(obs_->r[i]);
-      } else {
-        for (int k = 0; k < gl_.order; ++k) {
-          const detail::DipoleGradient g = model.at(std::sqrt(r0 * r0 + gl_.node[k] * (r1 * r1 - r0 * r0)));
-          sum.value += gl_.weight[k] * g.value;
-          sum.d_log_sigma_a += gl_.weight[k] * g.d_log_sigma_a;
-          sum.d_log_sigma_s += gl_.weight[k] * g.d_log_sigma_s;
+      const auto add = [&](double weight, double r) {
+        const detail::DipoleGradient g = model.at(r);
+        sum.value += weight * g.value;
+        sum.d_log_sigma_a += weight * g.d_log_sigma_a;
+        sum.d_log_sigma_s += weight * g.d_log_sigma_s;
+      };
+      if (!obs_->radial) {  // a pixel footprint (2D sample, or a bin of pixel averages)
+        const double p = obs_->pixel;
+        if (!(p > 0)) {
+          add(1.0, std::hypot(obs_->x[i], obs_->y[i]));
+        } else {
+          for (int a = 0; a < gl_.order; ++a) {
+            for (int b = 0; b < gl_.order; ++b) {
+              add(gl_.weight[a] * gl_.weight[b], std::hypot(obs_->x[i] + (gl_.node[a] - 0.5) * p,
+                                                            obs_->y[i] + (gl_.node[b] - 0.5) * p));
+            }
+          }
         }
+      } else if (!(obs_->r1[i] > obs_->r0[i])) {
+        add(1.0, obs_->r[i]);
+      } else {
+        const double r0 = obs_->r0[i], r1 = obs_->r1[i];
+        for (int k = 0; k < gl_.order; ++k) add(gl_.weight[k], std::sqrt(r0 * r0 + gl_.node[k] * (r1 * r1 - r0 * r0)));
       }
       const double v = sum.value + 1e-300;
       const double w = obs_->inv_rel_se[i];
@@ -131,6 +146,7 @@ class DipoleRadialCost : public ceres::CostFunction {
         jacobians[0][2 * i] = w * sum.d_log_sigma_a / v;
         jacobians[0][2 * i + 1] = w * sum.d_log_sigma_s / v;
       }
+      if (jacobians && jacobians[1]) jacobians[1][i] = w;
     }
     return true;
   }
@@ -138,8 +154,17 @@ class DipoleRadialCost : public ceres::CostFunction {
  private:
   const Observations* obs_;
   GaussLegendre gl_;
-  const double* log_scale_;
   const double* eta_;
+};
+
+// Prior on a calibration scale: log scale ~ N(0, relative_se).
+struct ScalePrior {
+  double inverse_se;
+  template <typename T>
+  bool operator()(const T* const log_scale, T* residual) const {
+    residual[0] = log_scale[0] * inverse_se;
+    return true;
+  }
 };
 
 // Far-field log-slope and total reflectance of one channel's radial bins: start values (DESIGN §6).
@@ -279,11 +304,18 @@ Observations observations_for(const ProfileData& d, int c, double exclude_mm, bo
     }
   } else {
     const RadialBins& b = d.radial;
+    if (b.pixel_mm > 0) {
+      // Bins of pixel averages: model each as a pixel footprint at the bin's mean radius.
+      o.radial = false;
+      o.pixel = b.pixel_mm;
+    }
     for (std::size_t i = 0; i < b.size(); ++i) {
       if (b.r_mm[i] < exclude_mm || !keep(b.value[c][i], b.standard_error[c][i])) continue;
       o.r.push_back(b.r_mm[i]);
       o.r0.push_back(b.r_inner_mm[i]);
       o.r1.push_back(b.r_outer_mm[i]);
+      o.x.push_back(b.r_mm[i]);
+      o.y.push_back(0.0);
       o.log_value.push_back(std::log(b.value[c][i]));
       o.inv_rel_se.push_back(b.value[c][i] / b.standard_error[c][i]);
     }
@@ -333,6 +365,55 @@ StartValues start_values(const ProfileData& d, int c, double eta, bool relative)
   const double sigma_t_reduced = sigma_tr / std::sqrt(3 * (1 - alpha));
   sv.sigma_a = (1 - alpha) * sigma_t_reduced;
   sv.sigma_s_reduced = alpha * sigma_t_reduced;
+
+  // The far-field slope and total need an exponential tail and most of the light inside the image;
+  // a profile that ends within a diffusion length has neither. So also search a coarse grid of
+  // (alpha', sigma_t') on a dozen bins and keep whichever start matches the data better: a few
+  // thousand dipole evaluations, cheap next to the solve, and the solve starts in the right valley.
+  std::vector<std::size_t> use;
+  for (std::size_t i = 0; i < d.radial.size(); ++i) {
+    if (d.radial.r_mm[i] > 0 && d.radial.value[c][i] > 2 * d.radial.standard_error[c][i]) use.push_back(i);
+  }
+  if (use.size() >= 4) {
+    std::vector<std::size_t> pick;
+    for (int k = 0; k < 12; ++k) pick.push_back(use[std::min(use.size() - 1, k * (use.size() - 1) / 11)]);
+    const double r_min = d.radial.r_mm[pick.front()], r_max = d.radial.r_mm[pick.back()];
+    const auto cost = [&](double sa, double ss, double* log_scale) {
+      const materials::StandardDipole<double> dipole(materials::Medium<double>::from_reduced(sa, ss, eta));
+      double sum = 0, sum2 = 0, wsum = 0;
+      std::array<double, 12> diff{}, w{};
+      for (std::size_t k = 0; k < pick.size(); ++k) {
+        const std::size_t i = pick[k];
+        const double m = fresnel * dipole.R_d(d.radial.r_mm[i]);
+        if (!(m > 0)) return double(INFINITY);
+        diff[k] = std::log(d.radial.value[c][i]) - std::log(m);
+        w[k] = std::pow(d.radial.value[c][i] / d.radial.standard_error[c][i], 2);
+        sum += w[k] * diff[k];
+        wsum += w[k];
+      }
+      const double shift = relative ? sum / wsum : 0.0;
+      for (std::size_t k = 0; k < pick.size(); ++k) sum2 += w[k] * std::pow(diff[k] - shift, 2);
+      if (log_scale) *log_scale = shift;
+      return sum2;
+    };
+    double best_shift = sv.log_scale;
+    double best = cost(sv.sigma_a, sv.sigma_s_reduced, &best_shift);
+    const double alphas[] = {0.05, 0.2, 0.4, 0.6, 0.8, 0.9, 0.95, 0.98, 0.99, 0.995, 0.998, 0.999, 0.9995, 0.9999};
+    for (double a : alphas) {
+      for (int k = 0; k < 16; ++k) {
+        const double st = 0.2 / r_max * std::pow(100.0 * r_max / r_min, k / 15.0);
+        double shift = 0;
+        const double value = cost((1 - a) * st, a * st, &shift);
+        if (value < best) {
+          best = value;
+          best_shift = shift;
+          sv.sigma_a = (1 - a) * st;
+          sv.sigma_s_reduced = a * st;
+        }
+      }
+    }
+    if (relative) sv.log_scale = best_shift;
+  }
   return sv;
 }
 
@@ -340,6 +421,7 @@ struct Problem {
   std::array<std::array<double, 2>, 3> ab{};
   double log_scale = 0;
   double eta = 1.3;
+  std::deque<std::array<double, 3>> calibration;  // per profile and channel: log scale with a prior
   std::deque<Observations> observations;  // owned: residual blocks point into it (stable)
 };
 
@@ -372,28 +454,43 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
   const bool shared_free = relative || options.fit_ior;
   std::array<int, 3> samples{};
   std::vector<std::pair<int, int>> block_channels;  // (channel, residuals) in insertion order
-  for (const ProfileData& d : data) {
+  std::vector<std::pair<double*, std::string>> calibration_blocks;
+  for (std::size_t di = 0; di < data.size(); ++di) {
+    const ProfileData& d = data[di];
     const bool use_2d = d.samples_2d.has_value() && d.incidence_polar_deg > 0;
+    p.calibration.push_back({0.0, 0.0, 0.0});
     for (int c = 0; c < 3; ++c) {
       if (!channels[c] || !d.channels[c]) continue;
       p.observations.push_back(observations_for(d, c, exclude_mm, use_2d, q, below_noise));
       const Observations& o = p.observations.back();
       if (o.log_value.empty()) continue;
       samples[c] += int(o.log_value.size());
-      if (options.loss == LossKind::kNone && !shared_free && options.analytic_derivatives &&
-          model == FitModel::kDipole && o.radial) {
-        problem.AddResidualBlock(new DipoleRadialCost(&o, gl, &p.log_scale, &p.eta), nullptr,
-                                 p.ab[c].data());
+      // The scale this capture's channel is known to: exact (held), fitted freely (relative), or
+      // within the calibration's uncertainty (a prior).
+      double* scale = &p.log_scale;
+      const double cal_se = d.calibrated && !relative ? d.calibration_relative_se[c] : 0.0;
+      if (cal_se > 0) {
+        scale = &p.calibration.back()[c];
+        problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ScalePrior, 1, 1>(new ScalePrior{1.0 / cal_se}),
+                                 nullptr, scale);
+        block_channels.emplace_back(-1, 1);  // the prior's residual: not a sample
+        calibration_blocks.emplace_back(scale, std::string("log calibration[") + kChannelNames[c] +
+                                                   (data.size() > 1 ? ", input " + std::to_string(di + 1) : "") + "]");
+      }
+      const bool scale_free = scale != &p.log_scale || relative;
+      if (options.loss == LossKind::kNone && !options.fit_ior && options.analytic_derivatives &&
+          model == FitModel::kDipole) {
+        problem.AddResidualBlock(new DipoleRadialCost(&o, gl, &p.eta), nullptr, p.ab[c].data(), scale);
         block_channels.emplace_back(c, int(o.log_value.size()));
-      } else if (options.loss == LossKind::kNone && !shared_free) {
+      } else if (options.loss == LossKind::kNone && !options.fit_ior && !scale_free) {
         auto* cost = new ceres::AutoDiffCostFunction<ChannelResiduals, ceres::DYNAMIC, 2>(
-            new ChannelResiduals{{&o, model, gl}, &p.log_scale, &p.eta}, int(o.log_value.size()));
+            new ChannelResiduals{{&o, model, gl}, scale, &p.eta}, int(o.log_value.size()));
         problem.AddResidualBlock(cost, nullptr, p.ab[c].data());
         block_channels.emplace_back(c, int(o.log_value.size()));
       } else if (options.loss == LossKind::kNone) {
         auto* cost = new ceres::AutoDiffCostFunction<ProfileResiduals, ceres::DYNAMIC, 2, 1, 1>(
             new ProfileResiduals{&o, model, gl}, int(o.log_value.size()));
-        problem.AddResidualBlock(cost, nullptr, p.ab[c].data(), &p.log_scale, &p.eta);
+        problem.AddResidualBlock(cost, nullptr, p.ab[c].data(), scale, &p.eta);
         block_channels.emplace_back(c, int(o.log_value.size()));
       } else {
         // A robust loss acts on each sample, so each gets its own block.
@@ -408,7 +505,7 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
           ceres::LossFunction* loss = options.loss == LossKind::kHuber
                                           ? static_cast<ceres::LossFunction*>(new ceres::HuberLoss(options.loss_scale))
                                           : new ceres::CauchyLoss(options.loss_scale);
-          problem.AddResidualBlock(cost, loss, p.ab[c].data(), &p.log_scale, &p.eta);
+          problem.AddResidualBlock(cost, loss, p.ab[c].data(), scale, &p.eta);
           block_channels.emplace_back(c, 1);
         }
       }
@@ -421,8 +518,8 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
                   " mm) and above the noise floor; at least 2 are needed for sigma_a and sigma_s'");
     }
   }
-  if (problem.HasParameterBlock(&p.log_scale)) {
-    if (!relative) problem.SetParameterBlockConstant(&p.log_scale);
+  if (problem.HasParameterBlock(&p.log_scale) && !relative) problem.SetParameterBlockConstant(&p.log_scale);
+  if (problem.HasParameterBlock(&p.eta)) {
     if (!options.fit_ior) problem.SetParameterBlockConstant(&p.eta);
     else problem.SetParameterLowerBound(&p.eta, 0, 1.0001), problem.SetParameterUpperBound(&p.eta, 0, 2.5);
   }
@@ -453,6 +550,7 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
   }
   if (relative) blocks.push_back(&p.log_scale), names.push_back("log scale");
   if (options.fit_ior) blocks.push_back(&p.eta), names.push_back("eta");
+  for (const auto& [block, name] : calibration_blocks) blocks.push_back(block), names.push_back(name);
 
   ceres::Problem::EvaluateOptions eo;
   eo.parameter_blocks = blocks;
@@ -505,14 +603,18 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
   }
   if (relative) fit.sd_scale = fit.scale * std::sqrt(std::max(0.0, covariance(k, k))), ++k;
   if (options.fit_ior) fit.sd_eta = std::sqrt(std::max(0.0, covariance(k, k))), ++k;
+  k += int(calibration_blocks.size());
   fit.parameters = k;
   // Per-channel chi^2 and rms from the residuals at the solution.
   {
     std::size_t offset = 0;
     std::array<double, 3> chi2{};
     for (const auto& [c, count] : block_channels) {
-      for (int i = 0; i < count; ++i, ++offset) chi2[c] += residuals[offset] * residuals[offset];
+      for (int i = 0; i < count; ++i, ++offset) {
+        if (c >= 0) chi2[c] += residuals[offset] * residuals[offset];
+      }
     }
+    fit.chi2 = chi2[0] + chi2[1] + chi2[2];  // the samples only, not the calibration priors
     for (int c = 0; c < 3; ++c) {
       fit.channels[c].chi2 = chi2[c];
       fit.channels[c].residual_rms = samples[c] ? std::sqrt(chi2[c] / samples[c]) : 0.0;

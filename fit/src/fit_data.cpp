@@ -115,11 +115,24 @@ ProfileData load_json(const std::filesystem::path& path) {
   ProfileData d;
   d.source = path.string();
   d.calibrated = p.calibrated;
+  if (p.beam_power && p.provenance.contains("white_reference")) {
+    const auto& white = p.provenance["white_reference"];
+    if (white.is_object() && white.contains("beam_power_standard_error") &&
+        white["beam_power_standard_error"].is_array() && white["beam_power_standard_error"].size() == 3) {
+      for (int c = 0; c < 3; ++c) {
+        const auto& se = white["beam_power_standard_error"][c];
+        if (se.is_number() && (*p.beam_power)[c] > 0) {
+          d.calibration_relative_se[c] = se.get<double>() / (*p.beam_power)[c];
+        }
+      }
+    }
+  }
   // TODO(ior): d.eta = p.ior once profiles carry the index
   d.incidence_polar_deg = p.incidence_polar_deg;
   d.incidence_azimuth_deg = p.incidence_azimuth_deg;
   d.view_deg = p.view_deg;
   d.radial.r_mm = p.radial.r_mm;
+  d.radial.pixel_mm = p.pixel_pitch_mm;
   d.radial.r_inner_mm = p.radial.r_inner_mm;
   d.radial.r_outer_mm = p.radial.r_outer_mm;
   for (int c = 0; c < 3; ++c) {

@@ -15,8 +15,16 @@
 
 namespace lucent::acquire {
 
+/// Where the exit radiance comes from.
+enum class RadianceSource {
+  kMonteCarlo,          ///< photon transport (the ground truth)
+  kDipole,              ///< the standard dipole: F_t(in) R_d(r) F_t(out) / pi, for round trips of the fit
+  kDirectionalDipole,   ///< the directional dipole: F_t(in) S_d F_t(out)
+};
+
 struct SimulateOptions {
   materials::Material material;
+  RadianceSource source = RadianceSource::kMonteCarlo;
   PhotonTransportOptions transport;  ///< media are filled from `material`
   CameraOptions camera;
   bool white_reference = true;       ///< image a Lambertian reference of reflectance 0.99
@@ -42,6 +50,11 @@ struct SimulateSummary {
 /// error, mm^-2 sr^-1) — or only truth.json with `profile_only`.
 SimulateSummary run_simulation(const SimulateOptions& options, const std::filesystem::path& out_dir,
                                const PhotonTransportProgress& progress = {});
+
+/// The exit radiance per unit power (mm^-2 sr^-1) that a diffusion model predicts on the simulation's
+/// pixel grid, each pixel averaged over 4 x 4 points (the entry point's pixel over 16 x 16).
+ImageRgb model_radiance(const materials::Material& material, RadianceSource source,
+                        const PhotonTransportOptions& geometry);
 
 /// The radiance image of a Lambertian reference of reflectance rho lit by the same beam (unit power):
 /// rho / pi times a Gaussian spot of width sigma_mm integrated over each pixel (per mm^2), so that

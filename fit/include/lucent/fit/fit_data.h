@@ -16,6 +16,10 @@ struct RadialBins {
   std::vector<double> r_outer_mm;
   std::array<std::vector<double>, 3> value;           ///< per mm^2 (or relative), per channel
   std::array<std::vector<double>, 3> standard_error;  ///< same units; > 0
+  /// Side of the square pixels the bins were averaged from, mm; 0 when the bins are annuli of a
+  /// continuous profile (Monte Carlo tallies, CSV). With pixels, a bin's value is the mean of pixel
+  /// averages around r_mm, and the model is averaged over a pixel footprint at r_mm.
+  double pixel_mm = 0;
   std::size_t size() const { return r_mm.size(); }
 };
 
@@ -31,6 +35,10 @@ struct Samples2d {
 struct ProfileData {
   std::string source;                ///< file it came from
   bool calibrated = true;            ///< false: values known up to one scale
+  /// Relative standard error of the calibration (the beam power from the white reference), per
+  /// channel; 0 when exact or unknown. The fit carries it as a per-channel scale with this prior, so
+  /// that the reported uncertainties include it.
+  std::array<double, 3> calibration_relative_se{};
   std::optional<double> eta;         ///< relative index when known (CSV: --ior)
   double incidence_polar_deg = 0;
   double incidence_azimuth_deg = 0;  ///< direction of travel from +x

@@ -1,0 +1,476 @@
+#include "lucent/acquire/profile.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <set>
+
+#include "lucent/acquire/hdr_merge.h"
+#include "lucent/materials/atomic_file.h"
+#include "lucent/materials/error.h"
+
+namespace lucent::acquire {
+namespace {
+
+using nlohmann::json;
+using nlohmann::ordered_json;
+
+constexpr const char* kCalibratedUnits = "per mm^2 (pi L / beam power)";
+constexpr const char* kRelativeUnits = "relative (pi L, uncalibrated)";
+
+template <typename T>
+ordered_json per_channel(const std::array<std::vector<T>, 3>& values) {
+  return ordered_json::array({values[0], values[1], values[2]});
+}
+
+// Objects indented, arrays of numbers on one line: a person can read the structure and the file
+// stays small (a 2D profile has one entry per pixel).
+void dump_compact(const ordered_json& value, int indent, std::string& out) {
+  const std::string pad(std::size_t(indent) + 2, ' ');
+  if (value.is_object() && !value.empty()) {
+    out += "{\n";
+    bool first = true;
+    for (const auto& [key, item] : value.items()) {
+      if (!first) out += ",\n";
+      first = false;
+      out += pad + ordered_json(key).dump() + ": ";
+      dump_compact(item, indent + 2, out);
+    }
+    out += "\n" + std::string(std::size_t(indent), ' ') + "}";
+  } else if (value.is_array() && std::any_of(value.begin(), value.end(), [](const ordered_json& e) {
+               return e.is_structured();
+             })) {
+    out += "[\n";
+    for (std::size_t i = 0; i < value.size(); ++i) {
+      out += pad;
+      dump_compact(value[i], indent + 2, out);
+      out += i + 1 < value.size() ? ",\n" : "\n";
+    }
+    out += std::string(std::size_t(indent), ' ') + "]";
+  } else {
+    out += value.dump();
+  }
+}
+
+ordered_json profile_to_ordered_json(const Profile& p) {
+  ordered_json doc;
+  doc["format"] = "lucent-profile";
+  doc["version"] = Profile::kFormatVersion;
+  doc["calibrated"] = p.calibrated;
+  doc["units"] = p.units();
+  doc["capture"] = p.capture;
+  doc["pixel_pitch_mm"] = p.pixel_pitch_mm;
+  doc["incidence"] = {{"polar_deg", p.incidence_polar_deg},
+                      {"azimuth_deg", p.incidence_azimuth_deg}};
+  doc["view_deg"] = p.view_deg;
+  doc["beam_point_px"] = {p.beam_point_px[0], p.beam_point_px[1]};
+  doc["beam_point_source"] = p.beam_point_source;
+  doc["beam_power"] = p.beam_power ? ordered_json(*p.beam_power) : ordered_json(nullptr);
+  const RadialProfile& r = p.radial;
+  doc["radial"] = {{"r_mm", r.r_mm},
+                   {"r_inner_mm", r.r_inner_mm},
+                   {"r_outer_mm", r.r_outer_mm},
+                   {"value", per_channel(r.value)},
+                   {"standard_error", per_channel(r.standard_error)},
+                   {"count", per_channel(r.count)}};
+  if (p.samples_2d) {
+    const Samples2d& s = *p.samples_2d;
+    doc["samples_2d"] = {{"x_mm", s.x_mm},
+                         {"y_mm", s.y_mm},
+                         {"value", per_channel(s.value)},
+                         {"standard_error", per_channel(s.standard_error)}};
+  }
+  doc["masked"] = {{"saturated", p.masked.saturated},
+                   {"black", p.masked.black},
+                   {"non_finite", p.masked.non_finite}};
+  doc["provenance"] = ordered_json::parse(p.provenance.is_null() ? "{}" : p.provenance.dump());
+  return doc;
+}
+
+class FieldReader {
+ public:
+  explicit FieldReader(std::string source) : source_(std::move(source)) {}
+
+  [[noreturn]] void fail(const std::string& field, const std::string& what) const {
+    throw Error(source_ + ": field '" + field + "': " + what);
+  }
+
+  const json& get(const json& object, const std::string& key, const std::string& field) const {
+    if (!object.contains(key)) fail(field, "missing");
+    return object[key];
+  }
+
+  double number(const json& value, const std::string& field) const {
+    if (!value.is_number())
+      fail(field, "expected a number, found " + std::string(value.type_name()));
+    const double v = value.get<double>();
+    if (!std::isfinite(v)) fail(field, "expected a finite number");
+    return v;
+  }
+
+  std::vector<double> numbers(const json& value, const std::string& field,
+                              std::optional<std::size_t> length = std::nullopt) const {
+    if (!value.is_array())
+      fail(field, "expected an array of numbers, found " + std::string(value.type_name()));
+    if (length && value.size() != *length) {
+      fail(field, "expected " + std::to_string(*length) + " numbers, found " +
+                      std::to_string(value.size()));
+    }
+    std::vector<double> out;
+    out.reserve(value.size());
+    for (std::size_t i = 0; i < value.size(); ++i) {
+      out.push_back(number(value[i], field + "[" + std::to_string(i) + "]"));
+    }
+    return out;
+  }
+
+  std::vector<std::int64_t> counts(const json& value, const std::string& field,
+                                   std::size_t length) const {
+    if (!value.is_array() || value.size() != length) {
+      fail(field,
+           "expected " + std::to_string(length) + " non-negative integers, found " +
+               (value.is_array() ? std::to_string(value.size()) : std::string(value.type_name())));
+    }
+    std::vector<std::int64_t> out;
+    for (std::size_t i = 0; i < value.size(); ++i) {
+      if (!value[i].is_number_integer() || value[i].get<std::int64_t>() < 0) {
+        fail(field + "[" + std::to_string(i) + "]", "expected a non-negative integer");
+      }
+      out.push_back(value[i].get<std::int64_t>());
+    }
+    return out;
+  }
+
+  // [[R...], [G...], [B...]], each of `length` numbers.
+  std::array<std::vector<double>, 3> channels(const json& value, const std::string& field,
+                                              std::size_t length, const std::string& per) const {
+    if (!value.is_array() || value.size() != 3) fail(field, "expected 3 arrays (R, G, B)");
+    std::array<std::vector<double>, 3> out;
+    for (int c = 0; c < 3; ++c) {
+      const std::string name = field + "[" + std::to_string(c) + "]";
+      if (!value[c].is_array() || value[c].size() != length) {
+        fail(name, "expected " + std::to_string(length) + " numbers (one per " + per + "), found " +
+                       (value[c].is_array() ? std::to_string(value[c].size())
+                                            : std::string(value[c].type_name())));
+      }
+      out[c] = numbers(value[c], name);
+    }
+    return out;
+  }
+
+  void only_known(const json& object, const std::string& prefix,
+                  const std::set<std::string>& known) const {
+    for (const auto& [key, item] : object.items()) {
+      if (!known.count(key)) fail(prefix + key, "unknown field");
+    }
+  }
+
+ private:
+  std::string source_;
+};
+
+std::string format_number(double value) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof buffer, "%.17g", value);
+  return buffer;
+}
+
+}  // namespace
+
+std::string Profile::units() const {
+  return calibrated ? kCalibratedUnits : kRelativeUnits;
+}
+
+json profile_to_json(const Profile& profile) {
+  return json::parse(profile_to_ordered_json(profile).dump());
+}
+
+Profile profile_from_json(const json& doc, const std::string& source) {
+  const FieldReader in(source);
+  if (!doc.is_object()) throw Error(source + ": expected a JSON object (a lucent-profile file)");
+  in.only_known(doc, "",
+                {"format", "version", "calibrated", "units", "capture", "pixel_pitch_mm",
+                 "incidence", "view_deg", "beam_point_px", "beam_point_source", "beam_power",
+                 "radial", "samples_2d", "masked", "provenance"});
+  if (!doc.contains("format") || doc["format"] != "lucent-profile") {
+    in.fail("format", "expected \"lucent-profile\", found " +
+                          (doc.contains("format") ? doc["format"].dump() : std::string("nothing")));
+  }
+  if (!doc.contains("version") || !doc["version"].is_number_integer() ||
+      doc["version"].get<long long>() != Profile::kFormatVersion) {
+    in.fail("version",
+            "this lucent reads profile version 1, found " +
+                (doc.contains("version") ? doc["version"].dump() : std::string("nothing")));
+  }
+  Profile p;
+  const json& calibrated = in.get(doc, "calibrated", "calibrated");
+  if (!calibrated.is_boolean()) in.fail("calibrated", "expected true or false");
+  p.calibrated = calibrated.get<bool>();
+  const json& units = in.get(doc, "units", "units");
+  if (units != p.units()) {
+    in.fail("units", "expected \"" + p.units() + "\" for a profile with calibrated " +
+                         (p.calibrated ? "true" : "false") + ", found " + units.dump());
+  }
+  const json& capture = in.get(doc, "capture", "capture");
+  if (!capture.is_string()) in.fail("capture", "expected a string (the capture file)");
+  p.capture = capture.get<std::string>();
+  p.pixel_pitch_mm = in.number(in.get(doc, "pixel_pitch_mm", "pixel_pitch_mm"), "pixel_pitch_mm");
+  if (!(p.pixel_pitch_mm > 0)) in.fail("pixel_pitch_mm", "expected a pixel pitch > 0 mm");
+  const json& incidence = in.get(doc, "incidence", "incidence");
+  if (!incidence.is_object()) in.fail("incidence", "expected {\"polar_deg\", \"azimuth_deg\"}");
+  in.only_known(incidence, "incidence.", {"polar_deg", "azimuth_deg"});
+  p.incidence_polar_deg =
+      in.number(in.get(incidence, "polar_deg", "incidence.polar_deg"), "incidence.polar_deg");
+  p.incidence_azimuth_deg =
+      in.number(in.get(incidence, "azimuth_deg", "incidence.azimuth_deg"), "incidence.azimuth_deg");
+  p.view_deg = in.number(in.get(doc, "view_deg", "view_deg"), "view_deg");
+  const auto point = in.numbers(in.get(doc, "beam_point_px", "beam_point_px"), "beam_point_px", 2);
+  p.beam_point_px = {point[0], point[1]};
+  const json& point_source = in.get(doc, "beam_point_source", "beam_point_source");
+  if (point_source != "detected" && point_source != "given") {
+    in.fail("beam_point_source",
+            "expected \"detected\" or \"given\", found " + point_source.dump());
+  }
+  p.beam_point_source = point_source.get<std::string>();
+  const json& power = in.get(doc, "beam_power", "beam_power");
+  if (!power.is_null()) {
+    const auto values = in.numbers(power, "beam_power", 3);
+    for (double v : values) {
+      if (!(v > 0)) in.fail("beam_power", "expected three powers > 0 (R, G, B) or null");
+    }
+    p.beam_power = std::array<double, 3>{values[0], values[1], values[2]};
+  }
+  if (p.calibrated && !p.beam_power)
+    in.fail("beam_power", "a calibrated profile needs the beam power");
+
+  const json& radial = in.get(doc, "radial", "radial");
+  if (!radial.is_object()) in.fail("radial", "expected an object");
+  in.only_known(radial, "radial.",
+                {"r_mm", "r_inner_mm", "r_outer_mm", "value", "standard_error", "count"});
+  RadialProfile& r = p.radial;
+  r.r_mm = in.numbers(in.get(radial, "r_mm", "radial.r_mm"), "radial.r_mm");
+  const std::size_t bins = r.r_mm.size();
+  r.r_inner_mm =
+      in.numbers(in.get(radial, "r_inner_mm", "radial.r_inner_mm"), "radial.r_inner_mm", bins);
+  r.r_outer_mm =
+      in.numbers(in.get(radial, "r_outer_mm", "radial.r_outer_mm"), "radial.r_outer_mm", bins);
+  r.value = in.channels(in.get(radial, "value", "radial.value"), "radial.value", bins, "r_mm");
+  r.standard_error = in.channels(in.get(radial, "standard_error", "radial.standard_error"),
+                                 "radial.standard_error", bins, "r_mm");
+  const json& count = in.get(radial, "count", "radial.count");
+  if (!count.is_array() || count.size() != 3)
+    in.fail("radial.count", "expected 3 arrays (R, G, B)");
+  for (int c = 0; c < 3; ++c) {
+    r.count[c] = in.counts(count[c], "radial.count[" + std::to_string(c) + "]", bins);
+  }
+  for (std::size_t i = 0; i < bins; ++i) {
+    if (!(r.r_inner_mm[i] >= 0 && r.r_inner_mm[i] < r.r_outer_mm[i])) {
+      in.fail("radial.r_inner_mm[" + std::to_string(i) + "]", "expected 0 <= r_inner < r_outer");
+    }
+  }
+
+  if (doc.contains("samples_2d")) {
+    const json& s2 = doc["samples_2d"];
+    if (!s2.is_object()) in.fail("samples_2d", "expected an object");
+    in.only_known(s2, "samples_2d.", {"x_mm", "y_mm", "value", "standard_error"});
+    Samples2d s;
+    s.x_mm = in.numbers(in.get(s2, "x_mm", "samples_2d.x_mm"), "samples_2d.x_mm");
+    s.y_mm = in.numbers(in.get(s2, "y_mm", "samples_2d.y_mm"), "samples_2d.y_mm", s.x_mm.size());
+    s.value = in.channels(in.get(s2, "value", "samples_2d.value"), "samples_2d.value",
+                          s.x_mm.size(), "sample");
+    s.standard_error = in.channels(in.get(s2, "standard_error", "samples_2d.standard_error"),
+                                   "samples_2d.standard_error", s.x_mm.size(), "sample");
+    p.samples_2d = std::move(s);
+  }
+
+  const json& masked = in.get(doc, "masked", "masked");
+  if (!masked.is_object()) in.fail("masked", "expected {\"saturated\", \"black\", \"non_finite\"}");
+  in.only_known(masked, "masked.", {"saturated", "black", "non_finite"});
+  const auto read_counts = [&](const char* key, std::array<std::int64_t, 3>& out) {
+    const std::string field = std::string("masked.") + key;
+    const auto values = in.counts(in.get(masked, key, field), field, 3);
+    std::copy(values.begin(), values.end(), out.begin());
+  };
+  read_counts("saturated", p.masked.saturated);
+  read_counts("black", p.masked.black);
+  read_counts("non_finite", p.masked.non_finite);
+  if (doc.contains("provenance")) {
+    if (!doc["provenance"].is_object()) in.fail("provenance", "expected an object");
+    p.provenance = doc["provenance"];
+  }
+  return p;
+}
+
+Profile read_profile(const std::filesystem::path& path) {
+  const std::string source = path.string();
+  std::ifstream file(path);
+  if (!file) throw Error(source + ": cannot open the profile file");
+  json doc;
+  try {
+    doc = json::parse(file);
+  } catch (const json::parse_error& e) {
+    std::string what = e.what();
+    const auto colon = what.find("]: ");  // drop nlohmann's "[json.exception.parse_error.101]"
+    throw Error(source + ": not valid JSON: " +
+                (colon != std::string::npos ? what.substr(colon + 3) : what));
+  }
+  return profile_from_json(doc, source);
+}
+
+void write_profile(const std::filesystem::path& path, const Profile& profile) {
+  std::string text;
+  dump_compact(profile_to_ordered_json(profile), 0, text);
+  write_file_atomically(path, text + "\n");
+}
+
+std::string profile_csv(const Profile& profile) {
+  std::string out = "r_mm,R_r,R_g,R_b,se_r,se_g,se_b,n_r,n_g,n_b\n";
+  const RadialProfile& r = profile.radial;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    out += format_number(r.r_mm[i]);
+    for (int c = 0; c < 3; ++c) out += "," + format_number(r.value[c][i]);
+    for (int c = 0; c < 3; ++c) out += "," + format_number(r.standard_error[c][i]);
+    for (int c = 0; c < 3; ++c) out += "," + std::to_string(r.count[c][i]);
+    out += "\n";
+  }
+  return out;
+}
+
+std::vector<double> radial_bin_edges_mm(const RadialBinning& binning, double pixel_pitch_mm) {
+  if (binning.bins < 1)
+    throw Error("bins: expected at least 1, found " + std::to_string(binning.bins));
+  if (!(binning.radius_mm > 0) || !std::isfinite(binning.radius_mm)) {
+    throw Error("radius_mm: expected a radius > 0 mm, found " + format_number(binning.radius_mm));
+  }
+  if (!(pixel_pitch_mm > 0)) throw Error("pixel_pitch_mm: expected a pixel pitch > 0 mm");
+  const int n = binning.bins;
+  std::vector<double> edges(std::size_t(n) + 1, 0.0);
+  if (!binning.log_bins || n == 1) {
+    for (int i = 0; i <= n; ++i) edges[i] = binning.radius_mm * i / n;
+    return edges;
+  }
+  const double first = pixel_pitch_mm / 2;
+  if (!(binning.radius_mm > first)) {
+    throw Error("radius_mm: " + format_number(binning.radius_mm) +
+                " mm is not above half a pixel pitch (" + format_number(first) +
+                " mm), too small for log-spaced bins");
+  }
+  for (int i = 1; i <= n; ++i) {
+    edges[i] = first * std::pow(binning.radius_mm / first, double(i - 1) / (n - 1));
+  }
+  edges[n] = binning.radius_mm;  // exact, whatever pow rounds to
+  return edges;
+}
+
+namespace {
+
+// Standard error of a bin's mean from the scatter of its pixels about a straight line in r (n >= 3;
+// the plain scatter for n = 2, 0 for one pixel). Centred sums keep the regression well conditioned.
+double detrended_standard_error(const std::vector<std::pair<double, double>>& samples, double mean,
+                                double m2) {
+  const double n = double(samples.size());
+  if (samples.size() < 2) return 0.0;
+  if (samples.size() < 3) return std::sqrt(m2 / (n - 1) / n);
+  double r_mean = 0;
+  for (const auto& s : samples) r_mean += s.first;
+  r_mean /= n;
+  double srr = 0, srv = 0;
+  for (const auto& [r, v] : samples) {
+    srr += (r - r_mean) * (r - r_mean);
+    srv += (r - r_mean) * (v - mean);
+  }
+  const double slope = srr > 0 ? srv / srr : 0.0;
+  double ss = 0;
+  for (const auto& [r, v] : samples) {
+    const double e = v - mean - slope * (r - r_mean);
+    ss += e * e;
+  }
+  return std::sqrt(ss / (n - 2) / n);
+}
+
+}  // namespace
+
+RadialProfile bin_radial_profile(const HdrResult& hdr, const std::array<double, 2>& beam_point_px,
+                                 double pixel_pitch_mm, const std::array<double, 3>& scale,
+                                 const RadialBinning& binning) {
+  const std::vector<double> edges = radial_bin_edges_mm(binning, pixel_pitch_mm);
+  const std::size_t bins = edges.size() - 1;
+  // Per bin and channel: the pixels' (r, value) for a scatter about the bin's own linear trend in r
+  // (the profile falls across a bin; scatter about the plain mean would count that fall as noise and
+  // overstate the error several times), and the propagated per-pixel errors.
+  struct Accumulator {
+    std::int64_t n = 0;
+    double mean = 0, m2 = 0, se2 = 0;
+    std::vector<std::pair<double, double>> samples;
+  };
+  std::vector<std::array<Accumulator, 3>> acc(bins);
+  std::vector<std::int64_t> pixels(bins, 0);
+  std::vector<double> sum_r(bins, 0.0);
+  for (int y = 0; y < hdr.height(); ++y) {
+    for (int x = 0; x < hdr.width(); ++x) {
+      const double r =
+          pixel_pitch_mm * std::hypot(x + 0.5 - beam_point_px[0], y + 0.5 - beam_point_px[1]);
+      if (r > edges.back()) continue;
+      const std::size_t bin = std::min<std::size_t>(
+          std::upper_bound(edges.begin(), edges.end(), r) - edges.begin() - 1, bins - 1);
+      bool any = false;
+      for (int c = 0; c < 3; ++c) {
+        if (!hdr.valid(x, y, c)) continue;
+        any = true;
+        Accumulator& a = acc[bin][c];
+        const double value = scale[c] * hdr.radiance.at(x, y, c);
+        const double se = scale[c] * hdr.standard_error.at(x, y, c);
+        ++a.n;
+        const double delta = value - a.mean;
+        a.mean += delta / double(a.n);
+        a.m2 += delta * (value - a.mean);
+        a.se2 += se * se;
+        a.samples.emplace_back(r, value);
+      }
+      if (any) ++pixels[bin], sum_r[bin] += r;
+    }
+  }
+  RadialProfile out;
+  const std::int64_t min_pixels = std::max(binning.min_pixels_per_bin, 1);
+  for (std::size_t b = 0; b < bins; ++b) {
+    bool enough = true;
+    for (int c = 0; c < 3; ++c) enough = enough && acc[b][c].n >= min_pixels;
+    if (!enough) continue;
+    out.r_mm.push_back(sum_r[b] / double(pixels[b]));
+    out.r_inner_mm.push_back(edges[b]);
+    out.r_outer_mm.push_back(edges[b + 1]);
+    for (int c = 0; c < 3; ++c) {
+      const Accumulator& a = acc[b][c];
+      const double n = double(a.n);
+      const double spread = detrended_standard_error(a.samples, a.mean, a.m2);
+      out.value[c].push_back(a.mean);
+      out.standard_error[c].push_back(std::max(spread, std::sqrt(a.se2) / n));
+      out.count[c].push_back(a.n);
+    }
+  }
+  return out;
+}
+
+Samples2d sample_2d_profile(const HdrResult& hdr, const std::array<double, 2>& beam_point_px,
+                            double pixel_pitch_mm, const std::array<double, 3>& scale,
+                            double radius_mm) {
+  Samples2d out;
+  for (int y = 0; y < hdr.height(); ++y) {
+    for (int x = 0; x < hdr.width(); ++x) {
+      const double dx = pixel_pitch_mm * (x + 0.5 - beam_point_px[0]);
+      const double dy = pixel_pitch_mm * (y + 0.5 - beam_point_px[1]);
+      if (std::hypot(dx, dy) > radius_mm) continue;
+      if (!hdr.valid(x, y, 0) || !hdr.valid(x, y, 1) || !hdr.valid(x, y, 2)) continue;
+      out.x_mm.push_back(dx);
+      out.y_mm.push_back(dy);
+      for (int c = 0; c < 3; ++c) {
+        out.value[c].push_back(scale[c] * hdr.radiance.at(x, y, c));
+        out.standard_error[c].push_back(scale[c] * hdr.standard_error.at(x, y, c));
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace lucent::acquire
