@@ -307,6 +307,7 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
   profile.incidence_polar_deg = capture.incidence_polar_deg;
   profile.incidence_azimuth_deg = capture.incidence_azimuth_deg;
   profile.view_deg = capture.view_deg;
+  profile.ior = capture.ior;
   profile.beam_point_px = bp;
   profile.beam_point_source = summary.beam_point_source;
   profile.beam_power = summary.beam_power;

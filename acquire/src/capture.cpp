@@ -138,7 +138,7 @@ Capture read_capture(const std::filesystem::path& path) {
   const FieldReader in(source);
   if (!doc.is_object()) throw Error(source + ": expected a JSON object (a lucent-capture file)");
   in.only_known(doc, "", {"format", "version", "images", "hdr", "pixel_pitch_mm", "incidence",
-                          "view_deg", "beam_point_px", "response", "dark", "white_reference",
+                          "view_deg", "ior", "beam_point_px", "response", "dark", "white_reference",
                           "beam_power", "provenance"});
   if (!doc.contains("format")) in.fail("format", "missing (expected \"lucent-capture\")");
   if (doc["format"] != "lucent-capture") {
@@ -172,6 +172,10 @@ Capture read_capture(const std::filesystem::path& path) {
   if (doc.contains("view_deg")) {
     c.view_deg = in.number(doc["view_deg"], "view_deg");
     if (!(c.view_deg >= 0 && c.view_deg < 90)) in.fail("view_deg", "expected [0, 90) degrees");
+  }
+  if (doc.contains("ior")) {
+    c.ior = in.number(doc["ior"], "ior");
+    if (!(*c.ior > 0 && *c.ior <= 4)) in.fail("ior", "expected a relative index in (0, 4]");
   }
   if (doc.contains("beam_point_px")) {
     const json& p = doc["beam_point_px"];
@@ -216,6 +220,7 @@ json capture_to_json(const Capture& c) {
   doc["pixel_pitch_mm"] = c.pixel_pitch_mm;
   doc["incidence"] = {{"polar_deg", c.incidence_polar_deg}, {"azimuth_deg", c.incidence_azimuth_deg}};
   doc["view_deg"] = c.view_deg;
+  if (c.ior) doc["ior"] = *c.ior;
   if (c.beam_point_px) doc["beam_point_px"] = {(*c.beam_point_px)[0], (*c.beam_point_px)[1]};
   doc["response"] = to_string(c.response);
   if (c.dark) doc["dark"] = c.dark->generic_string();

@@ -64,6 +64,7 @@ ordered_json profile_to_ordered_json(const Profile& p) {
   doc["incidence"] = {{"polar_deg", p.incidence_polar_deg},
                       {"azimuth_deg", p.incidence_azimuth_deg}};
   doc["view_deg"] = p.view_deg;
+  if (p.ior) doc["ior"] = *p.ior;
   doc["beam_point_px"] = {p.beam_point_px[0], p.beam_point_px[1]};
   doc["beam_point_source"] = p.beam_point_source;
   doc["beam_power"] = p.beam_power ? ordered_json(*p.beam_power) : ordered_json(nullptr);
@@ -191,7 +192,7 @@ Profile profile_from_json(const json& doc, const std::string& source) {
   if (!doc.is_object()) throw Error(source + ": expected a JSON object (a lucent-profile file)");
   in.only_known(doc, "",
                 {"format", "version", "calibrated", "units", "capture", "pixel_pitch_mm",
-                 "incidence", "view_deg", "beam_point_px", "beam_point_source", "beam_power",
+                 "incidence", "view_deg", "ior", "beam_point_px", "beam_point_source", "beam_power",
                  "radial", "samples_2d", "masked", "provenance"});
   if (!doc.contains("format") || doc["format"] != "lucent-profile") {
     in.fail("format", "expected \"lucent-profile\", found " +
@@ -225,6 +226,10 @@ Profile profile_from_json(const json& doc, const std::string& source) {
   p.incidence_azimuth_deg =
       in.number(in.get(incidence, "azimuth_deg", "incidence.azimuth_deg"), "incidence.azimuth_deg");
   p.view_deg = in.number(in.get(doc, "view_deg", "view_deg"), "view_deg");
+  if (doc.contains("ior")) {
+    p.ior = in.number(doc["ior"], "ior");
+    if (!(*p.ior > 0 && *p.ior <= 4)) in.fail("ior", "expected a relative index in (0, 4]");
+  }
   const auto point = in.numbers(in.get(doc, "beam_point_px", "beam_point_px"), "beam_point_px", 2);
   p.beam_point_px = {point[0], point[1]};
   const json& point_source = in.get(doc, "beam_point_source", "beam_point_source");

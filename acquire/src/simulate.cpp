@@ -202,6 +202,13 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
     capture.incidence_polar_deg = transport.incidence_deg;
     capture.incidence_azimuth_deg = transport.azimuth_deg;
     capture.view_deg = transport.view_deg;
+    capture.ior = options.material.ior;
+    // At oblique incidence the light emerges ahead of the entry point, so the brightest region no
+    // longer marks it; a real rig marks it (the specular glint, a fiducial). The simulator knows it:
+    // the corner between the four middle pixels.
+    if (transport.incidence_deg > 0) {
+      capture.beam_point_px = std::array<double, 2>{transport.size / 2.0, transport.size / 2.0};
+    }
     capture.response = options.camera.response;
     std::uint64_t stream = 0;
     for (std::size_t k = 0; k < options.camera.exposures_s.size(); ++k) {

@@ -1,6 +1,7 @@
 #include "lucent/fit/fit.h"
 
 #include <ceres/ceres.h>
+#include <glog/logging.h>
 #include <ceres/covariance.h>
 
 #include <Eigen/Dense>
@@ -629,6 +630,15 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
 }  // namespace
 
 FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& options) {
+  // Ceres logs (through glog) a warning with every residual of a rejected trial step that went
+  // non-finite; the solver handles those steps itself, and a user should see our one-line errors
+  // only. Errors still get through.
+  static const bool quiet = [] {
+    FLAGS_minloglevel = google::GLOG_ERROR;
+    FLAGS_logtostderr = true;
+    return true;
+  }();
+  (void)quiet;
   if (data.empty()) throw Error("fit: no input profile");
   for (const ProfileData& d : data) {
     if (d.radial.size() == 0 && !(d.samples_2d && d.samples_2d->size() > 0)) {

@@ -127,7 +127,7 @@ ProfileData load_json(const std::filesystem::path& path) {
       }
     }
   }
-  // TODO(ior): d.eta = p.ior once profiles carry the index
+  d.eta = p.ior;
   d.incidence_polar_deg = p.incidence_polar_deg;
   d.incidence_azimuth_deg = p.incidence_azimuth_deg;
   d.view_deg = p.view_deg;

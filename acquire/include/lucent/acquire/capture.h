@@ -39,6 +39,7 @@ struct Capture {
   double incidence_polar_deg = 0.0;   ///< beam angle from the normal, degrees, [0, 90)
   double incidence_azimuth_deg = 0.0; ///< beam direction in the image plane from +x, degrees
   double view_deg = 0.0;              ///< camera angle from the normal, degrees, [0, 90)
+  std::optional<double> ior;          ///< the sample's relative index, when known (fit uses it)
   std::optional<std::array<double, 2>> beam_point_px;  ///< given entry point (x, y) in pixels
   Response response = Response::kLinear;
   std::optional<std::filesystem::path> dark;           ///< dark frame, same camera settings

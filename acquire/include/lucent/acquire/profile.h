@@ -58,6 +58,7 @@ struct Profile {
   double incidence_polar_deg = 0;
   double incidence_azimuth_deg = 0;
   double view_deg = 0;
+  std::optional<double> ior;  ///< the sample's relative index when the capture states it
   /// Entry point in pixels; pixel (i, j) covers [i, i + 1) x [j, j + 1), its centre is (i + 0.5, j
   /// + 0.5).
   std::array<double, 2> beam_point_px{};
