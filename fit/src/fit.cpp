@@ -33,6 +33,7 @@ CaptureGeometry geometry_of(const ProfileData& d) {
   g.cos_view = std::cos(d.view_deg * kDegree);
   // The beam travels toward azimuth phi, so the light sits the other way.
   g.w_i = {-std::sin(theta) * std::cos(phi), -std::sin(theta) * std::sin(phi), std::cos(theta)};
+  g.exitance = d.exitance;
   return g;
 }
 
@@ -64,7 +65,8 @@ struct ProfileResiduals {
     using std::exp;
     using std::log;
     const materials::Medium<T> medium = materials::Medium<T>::from_reduced(exp(ab[0]), exp(ab[1]), eta);
-    const T log_front = log_scale + log(detail::fresnel_factor(obs->geometry, eta));
+    const T log_front =
+        log_scale + log(detail::fresnel_factor(obs->geometry, eta, model == FitModel::kDirectionalDipole));
     const std::size_t n = obs->log_value.size();
     if (model == FitModel::kDipole) {
       const materials::StandardDipole<T> dipole(medium);
@@ -113,7 +115,7 @@ class DipoleRadialCost : public ceres::CostFunction {
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     const double* ab = parameters[0];
     const detail::DipoleGradientModel model(std::exp(ab[0]), std::exp(ab[1]), *eta_);
-    const double log_front = parameters[1][0] + std::log(detail::fresnel_factor(obs_->geometry, *eta_));
+    const double log_front = parameters[1][0] + std::log(detail::fresnel_factor(obs_->geometry, *eta_, false));
     for (std::size_t i = 0; i < obs_->log_value.size(); ++i) {
       detail::DipoleGradient sum;
       const auto add = [&](double weight, double r) {
@@ -330,7 +332,7 @@ StartValues start_values(const ProfileData& d, int c, double eta, bool relative)
   double alpha = 0.99;
   const double A = materials::derive_coefficients(materials::Medium<double>{0, 1, 0, eta}).A_dipole;
   const CaptureGeometry g = geometry_of(d);
-  const double fresnel = detail::fresnel_factor(g, eta);
+  const double fresnel = detail::fresnel_factor(g, eta, false);
   if (!relative) {
     const double total = plane_total(d.radial, c, sigma_tr) / fresnel;
     if (total > 0 && total < 1) alpha = materials::reduced_albedo_from_total_reflectance(total, eta);
@@ -587,6 +589,7 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
   fit.chi2 = 2 * summary.final_cost;
   fit.eta = p.eta;
   fit.scale = std::exp(p.log_scale);
+  for (int c = 0; c < 3; ++c) fit.calibration_scale[c] = std::exp(p.calibration.front()[c]);
   int k = 0;
   for (int c = 0; c < 3; ++c) {
     ChannelFit& ch = fit.channels[c];
@@ -615,7 +618,8 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
         if (c >= 0) chi2[c] += residuals[offset] * residuals[offset];
       }
     }
-    fit.chi2 = chi2[0] + chi2[1] + chi2[2];  // the samples only, not the calibration priors
+    // fit.chi2 (AIC, BIC) keeps the calibration priors' share: a model that reaches the data only by
+    // rescaling the calibration far beyond its uncertainty pays for it.
     for (int c = 0; c < 3; ++c) {
       fit.channels[c].chi2 = chi2[c];
       fit.channels[c].residual_rms = samples[c] ? std::sqrt(chi2[c] / samples[c]) : 0.0;
@@ -736,6 +740,17 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
           << ddipole.aic << ")";
     }
     result.reason = why.str();
+  }
+  for (int c = 0; c < 3; ++c) {
+    const double s = result.chosen.calibration_scale[c];
+    const double se = data.front().calibration_relative_se[c];
+    if (se > 0 && std::abs(std::log(s)) > 3 * se) {
+      std::ostringstream note;
+      note.precision(3);
+      note << "channel " << kChannelNames[c] << ": the model reaches the data only with the calibration scaled by "
+           << s << " (its uncertainty is " << 100 * se << "%): model and data disagree in absolute level";
+      result.notes.push_back(note.str());
+    }
   }
   if (!result.chosen.undetermined.empty()) {
     for (const std::string& u : result.chosen.undetermined) {

@@ -47,6 +47,7 @@ ProfileData load_csv(const std::filesystem::path& path) {
   }
   ProfileData d;
   d.source = source;
+  d.exitance = true;  // CSV values are per mm^2 per unit power entering the sample
   std::array<int, 3> value_col{-1, -1, -1}, se_col{-1, -1, -1};
   const char* suffix[3] = {"_r", "_g", "_b"};
   if (has("R")) {

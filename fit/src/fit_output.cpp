@@ -39,6 +39,7 @@ json model_fit_json(const ModelFit& f) {
           {"sd_eta", f.sd_eta},
           {"scale", f.scale},
           {"sd_scale", f.sd_scale},
+          {"calibration_scale", f.calibration_scale},
           {"converged", f.converged},
           {"iterations", f.iterations},
           {"time_ms", f.time_ms},

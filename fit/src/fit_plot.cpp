@@ -15,11 +15,15 @@ double predicted_radial(const ModelFit& fit, const ProfileData& data, int c, dou
   detail::CaptureGeometry g;
   g.cos_incidence = std::cos(data.incidence_polar_deg * std::numbers::pi / 180);
   g.cos_view = std::cos(data.view_deg * std::numbers::pi / 180);
-  const detail::GaussLegendre gl = detail::gauss_legendre(1);
-  const double v = fit.model == FitModel::kDipole
-                       ? detail::dipole_annulus(materials::StandardDipole<double>(medium), r, r, r, gl)
-                       : detail::ddipole_annulus(materials::DirectionalDipole<double>(medium), r, r, r, gl);
-  return fit.scale * detail::fresnel_factor(g, fit.eta) * v;
+  g.exitance = data.exitance;
+  // What the fit compares with: a pixel footprint at r when the bins are pixel averages.
+  const detail::GaussLegendre gl = detail::gauss_legendre(2);
+  const double p = data.radial.pixel_mm;
+  const double v =
+      fit.model == FitModel::kDipole
+          ? detail::dipole_pixel(materials::StandardDipole<double>(medium), r, 0.0, p, gl)
+          : detail::ddipole_pixel(materials::DirectionalDipole<double>(medium), g, r, 0.0, p, gl);
+  return fit.scale * fit.calibration_scale[c] * detail::fresnel_factor(g, fit.eta, fit.model == FitModel::kDirectionalDipole) * v;
 }
 
 void write_fit_plot(const std::filesystem::path& path, const FitResult& result,
@@ -33,15 +37,14 @@ void write_fit_plot(const std::filesystem::path& path, const FitResult& result,
   PlotPanel profile;
   profile.title = "profile: data (points, +-1 SE) and " +
                   std::string(f.model == FitModel::kDipole ? "standard dipole" : "directional dipole") +
-                  " fit (lines); excluded region in light colours";
+                  " fit (lines); excluded region in light colours; y: " +
+                  (data.calibrated ? "pi L / P (1/mm^2)" : "pi L (relative)");
   profile.x_label = "r (mm)";
-  profile.y_label = data.calibrated ? "pi L / P (1/mm^2)" : "pi L (relative)";
   profile.log_y = true;
   profile.height_weight = 2.2;
   PlotPanel residuals;
-  residuals.title = "residuals: log(model / data) / relative SE";
+  residuals.title = "residuals: log(model / data) / relative SE (lines at 0 and +-2)";
   residuals.x_label = "r (mm)";
-  residuals.y_label = "SE";
   residuals.horizontal_lines = {0.0, -2.0, 2.0};
   const RadialBins& b = data.radial;
   double r_max = 0;
@@ -90,8 +93,10 @@ void write_fit_plot(const std::filesystem::path& path, const FitResult& result,
                   ch.correlation, ch.residual_rms, ch.samples);
     footer.push_back(line);
   }
-  std::snprintf(line, sizeof line, "eta %.3f, scale %.4g, exclusion radius %.3g mm, %s in %d iterations, %.2f ms",
-                f.eta, f.scale, result.exclude_radius_mm, f.converged ? "converged" : "NOT converged",
+  std::snprintf(line, sizeof line,
+                "eta %.3f, scale %.4g, calibration %.4f %.4f %.4f, exclusion radius %.3g mm, %s in %d iterations, %.2f ms",
+                f.eta, f.scale, f.calibration_scale[0], f.calibration_scale[1], f.calibration_scale[2],
+                result.exclude_radius_mm, f.converged ? "converged" : "NOT converged",
                 f.iterations, f.time_ms);
   footer.push_back(line);
   footer.push_back("model choice: " + result.reason);

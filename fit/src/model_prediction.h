@@ -25,11 +25,20 @@ struct CaptureGeometry {
   double cos_incidence = 1;    ///< cos of the beam's polar angle
   double cos_view = 1;         ///< cos of the camera's polar angle
   std::array<double, 3> w_i{0, 0, 1};  ///< unit, from the entry point toward the light
+  /// The data are exitance per unit power entering the sample (Monte Carlo tallies, CSV), not a
+  /// camera's radiance per unit incident power.
+  bool exitance = false;
 };
 
+/// What multiplies the model's R_d (dipole) or pi S_d (ddipole) to give the measured quantity: both
+/// Fresnel transmittances for a camera (pi L / P); for exitance per unit power entering, nothing for
+/// the dipole (R_d is an exitance) and the outgoing hemispherical transmittance for the ddipole,
+/// pi S_d integrated against F_t cos over the hemisphere: eta^2 (1 - F_dr(eta)) (transmittance from
+/// inside is 1 - F_dr, from outside eta^2 times that).
 template <typename T>
-T fresnel_factor(const CaptureGeometry& g, const T& eta) {
+T fresnel_factor(const CaptureGeometry& g, const T& eta, bool directional) {
   using materials::fresnel_transmittance;
+  if (g.exitance) return directional ? eta * eta * (T(1) - materials::diffuse_fresnel_reflectance(eta)) : T(1);
   return fresnel_transmittance(T(g.cos_incidence), eta) * fresnel_transmittance(T(g.cos_view), eta);
 }
 

@@ -64,6 +64,8 @@ struct ModelFit {
   double eta = 1.3;
   double sd_eta = 0;
   double scale = 1.0, sd_scale = 0;   ///< global scale (1 when calibrated and not fitted)
+  /// Per channel, the first input's calibration scale as fitted within its prior (1 when exact).
+  std::array<double, 3> calibration_scale{1.0, 1.0, 1.0};
   bool converged = false;
   int iterations = 0;
   double time_ms = 0;                 ///< solve + covariance, ms

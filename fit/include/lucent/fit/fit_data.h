@@ -43,6 +43,8 @@ struct ProfileData {
   double incidence_polar_deg = 0;
   double incidence_azimuth_deg = 0;  ///< direction of travel from +x
   double view_deg = 0;
+  /// Exitance per unit power entering (CSV, Monte Carlo tallies) rather than pi L / P from a camera.
+  bool exitance = false;
   RadialBins radial;
   std::optional<Samples2d> samples_2d;
   std::array<bool, 3> channels{true, true, true};  ///< which channels carry data
