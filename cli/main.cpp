@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   lucent::cli::register_simulate_command(app);
   lucent::cli::register_acquire_command(app);
   lucent::cli::register_fit_command(app);
+  lucent::cli::register_bench_command(app);
 
   try {
     app.parse(argc, argv);

@@ -95,6 +95,13 @@ void draw_panel(cv::Mat& img, const PlotPanel& panel, cv::Rect area) {
     return cv::Point(int(std::lround(px(x))) - plot.x, int(std::lround(py(y))) - plot.y);
   };
   int legend_row = 0;
+  int legend_width = 0;
+  for (const PlotSeries& s : panel.series) {
+    int baseline = 0;
+    if (!s.label.empty()) {
+      legend_width = std::max(legend_width, cv::getTextSize(s.label, font, 0.45, 1, &baseline).width);
+    }
+  }
   for (const PlotSeries& s : panel.series) {
     const cv::Scalar colour = bgr(s.rgb);
     bool have_previous = false;
@@ -114,7 +121,7 @@ void draw_panel(cv::Mat& img, const PlotPanel& panel, cv::Rect area) {
       have_previous = true;
     }
     if (!s.label.empty()) {
-      const cv::Point at(plot.width - 210, 18 + 18 * legend_row++);
+      const cv::Point at(std::max(4, plot.width - legend_width - 40), 18 + 18 * legend_row++);
       cv::line(clip, at + cv::Point(0, -4), at + cv::Point(20, -4), colour, 2, cv::LINE_AA);
       cv::putText(clip, s.label, at + cv::Point(26, 0), font, 0.45, colour, 1, cv::LINE_AA);
     }

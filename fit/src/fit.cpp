@@ -532,7 +532,7 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
   so.function_tolerance = q.function_tolerance;
   so.parameter_tolerance = q.parameter_tolerance;
   so.gradient_tolerance = 1e-14;
-  so.max_num_iterations = q.max_iterations;
+  so.max_num_iterations = options.max_iterations > 0 ? options.max_iterations : q.max_iterations;
   so.logging_type = ceres::SILENT;
   so.num_threads = 1;
 

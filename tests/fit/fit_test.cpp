@@ -135,6 +135,30 @@ TEST(Fit, ScaleAndAlbedoTogetherAreUndeterminedInTheFarFieldOnly) {
   EXPECT_FALSE(r.chosen.undetermined.empty());
 }
 
+TEST(Fit, UnconvergedFitSaysSoUnlessAllowed) {
+  const materials::Material m = materials::load_material("marble");
+  FitOptions o;
+  o.model = FitModel::kDipole;
+  o.max_iterations = 1;
+  std::array<std::array<double, 2>, 3> start{};
+  for (int c = 0; c < 3; ++c) start[c] = {30 * m.sigma_a[c], 0.1 * m.sigma_s_reduced[c]};
+  o.start = start;
+  ProfileData d = model_profile(m, FitModel::kDipole);
+  for (int c = 0; c < 3; ++c) {  // a profile the model cannot fit exactly: the solver must iterate
+    for (std::size_t i = 0; i < d.radial.size(); ++i) d.radial.value[c][i] *= 1 + 0.05 * std::sin(double(i));
+  }
+  try {
+    fit_profiles({d}, o);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("did not converge"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("best values"), std::string::npos) << e.what();
+  }
+  o.allow_unconverged = true;
+  const FitResult r = fit_profiles({d}, o);
+  EXPECT_FALSE(r.chosen.converged);
+}
+
 TEST(Fit, BadInputs) {
   const materials::Material m = materials::load_material("marble");
   EXPECT_THROW(fit_profiles({}, FitOptions{}), Error);

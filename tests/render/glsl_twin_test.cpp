@@ -57,6 +57,14 @@ void main() {
 }
 )glsl";
 
+// double(float(v)), kept: g++ 12.2 at -O2 (tree SLP vectorisation) drops the double -> float ->
+// double round trip when it is applied to the components of Eigen vectors, silently leaving the
+// "float-representable" inputs unrounded (reproduced in isolation; -fno-tree-vectorize restores it).
+double to_float(double v) {
+  volatile float f = static_cast<float>(v);
+  return f;
+}
+
 struct Config {
   Medium<double> medium;
   Vec3d x_i, n_i, w_i, x_o, n_o;
@@ -123,7 +131,6 @@ class ConfigGenerator {
       }
     }
     // Both evaluations get the same float-representable inputs.
-    const auto to_float = [](double v) { return double(float(v)); };
     c.medium = Medium<double>{to_float(c.medium.sigma_a), to_float(c.medium.sigma_s),
                               to_float(c.medium.g), to_float(c.medium.eta)};
     for (Vec3d* v : {&c.x_i, &c.n_i, &c.w_i, &c.x_o, &c.n_o}) {
@@ -148,6 +155,55 @@ class ConfigGenerator {
 
 double ddipole_double(const Config& c) {
   return materials::DirectionalDipole<double>(c.medium).S_d(c.x_i, c.n_i, c.w_i, c.x_o, c.n_o);
+}
+
+double ddipole_float(const Config& c) {
+  const Medium<float> m{float(c.medium.sigma_a), float(c.medium.sigma_s), float(c.medium.g),
+                        float(c.medium.eta)};
+  return materials::DirectionalDipole<float>(m).S_d(c.x_i.cast<float>(), c.n_i.cast<float>(),
+                                                    c.w_i.cast<float>(), c.x_o.cast<float>(),
+                                                    c.n_o.cast<float>());
+}
+
+// The two sources of S_d = S'_real - S'_virtual in the plain form of the authors' sample code (DESIGN
+// §4.1), in long double: only to measure how much the difference cancels. cancellation = (|S'_real|
+// + |S'_virtual|) / |S_d| multiplies every rounding made before the subtraction; no float formulation
+// of S_d can do better than about eps times it near the zero crossing (where it is clamped).
+double cancellation(const Config& c) {
+  using R = long double;
+  using V = Eigen::Matrix<R, 3, 1>;
+  const auto k = materials::derive_coefficients(c.medium);
+  const V x_i = c.x_i.cast<R>(), n_i = c.n_i.cast<R>(), w_i = c.w_i.cast<R>(), x_o = c.x_o.cast<R>(),
+          n_o = c.n_o.cast<R>();
+  const R D = k.D, sigma_tr = k.sigma_tr, d_e = k.d_e, eta = k.eta;
+  const auto profile = [&](const V& x, const V& w, R r) {
+    const R s = sigma_tr * r;
+    return R(k.normalisation) / (4 * M_PI * M_PI) * std::exp(-s) / (r * r * r) *
+           (R(k.C_phi) * (r * r / D + 3 * (1 + s) * x.dot(w)) -
+            R(k.C_E) * (3 * D * (1 + s) * w.dot(n_o) -
+                        ((1 + s) + 3 * D * (3 * (1 + s) + s * s) / (r * r) * x.dot(w)) * x.dot(n_o)));
+  };
+  const V x = x_o - x_i;
+  const R r = x.norm();
+  V n_star = n_i;
+  const V nx = n_i.cross(x);
+  if (r > 0 && nx.norm() > 1e-12L * r) n_star = (x / r).cross(nx.normalized());
+  const R cos_i = w_i.dot(n_i);
+  const R rad = std::max(R(0), 1 - (1 - cos_i * cos_i) / (eta * eta));
+  const V w_r = (-w_i / eta - n_i * (-cos_i / eta + std::sqrt(rad))).normalized();
+  const V w_v = w_r - 2 * w_r.dot(n_star) * n_star;
+  const R mu0 = -n_o.dot(w_r);
+  R d_r2;
+  if (mu0 > 0) {
+    const R cos_beta = -std::sqrt(std::max(R(0), (r * r - x.dot(w_r) * x.dot(w_r)) / (r * r + d_e * d_e)));
+    d_r2 = r * r + D * mu0 * (D * mu0 - 2 * d_e * cos_beta);
+  } else {
+    d_r2 = r * r + 1 / (9 * R(k.sigma_t) * R(k.sigma_t));
+  }
+  const V x_v = x_i + 2 * R(k.A_ddipole) * d_e * n_star;
+  const R real = profile(x, w_r, std::sqrt(d_r2));
+  const R virt = profile(x_o - x_v, w_v, (x_o - x_v).norm());
+  return double((std::abs(real) + std::abs(virt)) / std::abs(real - virt));
 }
 
 // How far the double result moves when every input is nudged by a few float roundings (relative
@@ -243,13 +299,16 @@ TEST_F(GlslTwinTest, DirectionalDipoleMatchesDoubleModel) {
     max_S = std::max(max_S, reference[i]);
   }
   std::mt19937_64 rng(7);
-  int compared = 0, within = 0, conditioning = 0, bad = 0, front = 0, back = 0;
+  int compared = 0, within = 0, conditioning = 0, bad = 0, front = 0, back = 0, zero = 0;
   double worst = 0;
   for (int i = 0; i < kConfigs; ++i) {
     const Config& c = configs[i];
     const double S = reference[i], S_glsl = glsl[std::size_t(i) * kOutputs];
     ASSERT_TRUE(std::isfinite(S_glsl) && S_glsl >= 0) << c.kind << " " << c.medium.to_string();
-    if (!(S > 1e-20 * max_S)) continue;
+    if (!(S > 1e-20 * max_S)) {
+      zero += S == 0;
+      continue;
+    }
     ++compared;
     (std::string(c.kind).find("back") == std::string::npos ? front : back) += 1;
     const double e = std::abs(S_glsl - S) / S;
@@ -260,15 +319,20 @@ TEST_F(GlslTwinTest, DirectionalDipoleMatchesDoubleModel) {
       ++conditioning;
     } else if (++bad <= 5) {
       ADD_FAILURE() << c.kind << " " << c.medium.to_string() << " r=" << c.r << " S=" << S
-                    << " S_glsl=" << S_glsl << " relative error " << e;
+                    << " S_glsl=" << S_glsl << " relative error " << e
+                    << " (C++ float: " << std::abs(ddipole_float(c) - S) / S
+                    << ", cancellation " << cancellation(c) << ")";
     }
   }
   std::printf("ddipole GLSL vs C++ double: %d of %d compared (S > 1e-20 max = %.3g; %d front-lit, "
-              "%d back-lit), %d within 1e-4, %d beyond it but within what float "
-              "rounding of the inputs causes, %d neither; worst relative error %.3g\n",
-              compared, kConfigs, 1e-20 * max_S, front, back, within, conditioning, bad, worst);
+              "%d back-lit; %d more are clamped to exactly 0 by the model), %d within 1e-4, %d "
+              "beyond it but within what float rounding of the inputs causes, %d neither; worst "
+              "relative error %.3g\n",
+              compared, kConfigs, 1e-20 * max_S, front, back, zero, within, conditioning, bad, worst);
   EXPECT_EQ(bad, 0);
-  EXPECT_GT(compared, kConfigs * 9 / 10);
+  // About a sixth of the configurations sit where S_d = max(0, real - virtual) is clamped to 0
+  // (back-lit and far points); the rest, well above the 10^4 asked for, are compared.
+  EXPECT_GT(compared, 15000);
   EXPECT_GT(within, 0.995 * compared);
 }
 
@@ -309,13 +373,25 @@ TEST_F(GlslTwinTest, FresnelTransmittanceMatchesDoubleModel) {
   std::vector<Config> configs;
   for (int i = 0; i < 4000; ++i) configs.push_back(generator.next(i));
   const std::vector<float> glsl = evaluate_glsl(configs);
+  int near_critical = 0;
   for (std::size_t i = 0; i < configs.size(); ++i) {
     const Config& c = configs[i];
     const double T = materials::fresnel_transmittance(c.w_i.dot(c.n_i), c.medium.eta);
-    // Absolute: T is in [0, 1] and its cos_i is itself a float dot product.
-    ASSERT_NEAR(glsl[i * kOutputs + 2], T, 2e-6) << "cos_i=" << c.w_i.dot(c.n_i)
-                                                  << " eta=" << c.medium.eta;
+    const float T_float = materials::fresnel_transmittance(
+        c.w_i.cast<float>().dot(c.n_i.cast<float>()), float(c.medium.eta));
+    const double e = std::abs(glsl[i * kOutputs + 2] - T);
+    // Absolute: T is in [0, 1]. Near the critical angle (eta < 1) 1 - sin^2 theta_t cancels and
+    // any float evaluation, the C++ float one included, loses digits: there the GLSL result must be
+    // as close as four times the C++ float error.
+    if (e > 2e-6) {
+      ++near_critical;
+      ASSERT_LE(e, 4 * std::abs(T_float - T) + 1e-6)
+          << "cos_i=" << c.w_i.dot(c.n_i) << " eta=" << c.medium.eta;
+    }
   }
+  std::printf("Fresnel: %zu compared, %d near the critical angle beyond 2e-6 (within 4x the C++ "
+              "float error)\n", configs.size(), near_critical);
+  EXPECT_LT(near_critical, 40);
 }
 
 TEST_F(GlslTwinTest, IncludesResolveAndReportFileNames) {

@@ -33,6 +33,7 @@ struct FitOptions {
   /// derivatives (ceres::Jet) otherwise. Same answer (tests/fit), measured faster (bench_fit).
   bool analytic_derivatives = true;
   bool allow_unconverged = false;
+  int max_iterations = 0;           ///< solver iterations at most; 0 = what --quality sets
   /// Start values per channel {sigma_a, sigma_s'} in mm^-1 instead of the data's (far-field slope
   /// and total reflectance); for tests and for users who know better.
   std::optional<std::array<std::array<double, 2>, 3>> start;

@@ -1,0 +1,160 @@
+#include "lucent/fit/fit_bench.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <ostream>
+#include <sstream>
+#include <unistd.h>
+
+#include "lucent/acquire/acquire.h"
+#include "lucent/acquire/plot.h"
+#include "lucent/acquire/simulate.h"
+#include "lucent/fit/fit.h"
+#include "lucent/materials/atomic_file.h"
+#include "lucent/materials/error.h"
+
+namespace lucent::fit {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct BenchCase {
+  std::string name;
+  ProfileData data;
+  materials::Material truth;
+};
+
+// Simulated with a diffusion model as the source: the truth is exact for that model.
+BenchCase model_case(const std::string& name, const std::string& material, acquire::RadianceSource source,
+                     double incidence_deg, int size, const fs::path& scratch) {
+  acquire::SimulateOptions o;
+  o.material = materials::load_material(material);
+  o.source = source;
+  o.transport.size = size;
+  o.transport.pixel_mm = 0.3;
+  o.transport.incidence_deg = incidence_deg;
+  o.camera.seed = 7;
+  const fs::path sim = scratch / (name + "-sim"), acq = scratch / (name + "-acq");
+  acquire::run_simulation(o, sim);
+  acquire::run_acquire(sim / "capture.json", acq);
+  return {name, load_profile_data(acq / "profile.json"), o.material};
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+}  // namespace
+
+int run_fit_bench(const FitBenchOptions& options, std::ostream& log) {
+  if (options.repeats < 1) throw Error("--repeats: expected at least 1");
+  const fs::path scratch = fs::temp_directory_path() / ("lucent-bench-fit-" + std::to_string(::getpid()));
+  fs::remove_all(scratch);
+  fs::create_directories(scratch);
+  struct Cleanup {
+    fs::path dir;
+    ~Cleanup() { std::error_code ec; fs::remove_all(dir, ec); }
+  } cleanup{scratch};
+
+  std::vector<BenchCase> cases;
+  log << "bench fit: preparing captures\n";
+  cases.push_back(model_case("potato-dipole-0deg", "potato", acquire::RadianceSource::kDipole, 0,
+                             options.size_px, scratch));
+  cases.push_back(model_case("skin1-ddipole-0deg", "skin1", acquire::RadianceSource::kDirectionalDipole, 0,
+                             options.size_px, scratch));
+  cases.push_back(model_case("marble-ddipole-45deg", "marble", acquire::RadianceSource::kDirectionalDipole,
+                             45, options.size_px, scratch));
+  if (fs::exists(options.sample_capture)) {
+    const fs::path acq = scratch / "sample-acq";
+    acquire::run_acquire(options.sample_capture, acq);
+    std::ifstream truth_file(options.sample_capture.parent_path() / "truth.json");
+    const auto truth = nlohmann::json::parse(truth_file);
+    cases.push_back({"marble-montecarlo-0deg", load_profile_data(acq / "profile.json"),
+                     materials::material_from_json(truth["material"], "truth.json")});
+  } else {
+    log << "bench fit: " << options.sample_capture << " not found; the Monte Carlo case is skipped\n";
+  }
+
+  std::ostringstream csv;
+  csv << "case,model,quality,derivatives,time_ms_median,samples,sigma_a_rel_error,"
+         "sigma_s_reduced_rel_error,residual_rms\n";
+  struct Point { double time_ms, error; int series; };
+  std::vector<Point> points;
+  std::vector<std::string> series_names;
+  int settings = 0;
+  const char* quality_names[3] = {"fast", "balanced", "accurate"};
+  for (const BenchCase& bc : cases) {
+    for (FitModel model : {FitModel::kDipole, FitModel::kDirectionalDipole}) {
+      for (bool analytic : {true, false}) {
+        if (analytic && model != FitModel::kDipole) continue;  // analytic Jacobian: dipole only
+        const std::string series = bc.name + " / " + (model == FitModel::kDipole ? "dipole" : "ddipole") +
+                                   (model == FitModel::kDipole ? (analytic ? " analytic" : " autodiff") : "");
+        series_names.push_back(series);
+        for (int q = 0; q < 3; ++q) {
+          FitOptions fo;
+          fo.model = model;
+          fo.quality = Quality(q);
+          fo.analytic_derivatives = analytic;
+          fo.allow_unconverged = true;
+          std::vector<double> times;
+          FitResult result;
+          for (int k = 0; k < options.repeats; ++k) {
+            const auto t0 = std::chrono::steady_clock::now();
+            result = fit_profiles({bc.data}, fo);
+            times.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+          }
+          double err_a = 0, err_s = 0, rms = 0;
+          int n = 0;
+          for (int c = 0; c < 3; ++c) {
+            const ChannelFit& f = result.chosen.channels[c];
+            if (f.samples == 0) continue;
+            err_a += std::abs(f.sigma_a / bc.truth.sigma_a[c] - 1);
+            err_s += std::abs(f.sigma_s_reduced / bc.truth.sigma_s_reduced[c] - 1);
+            rms += f.residual_rms;
+            ++n;
+          }
+          err_a /= n, err_s /= n, rms /= n;
+          const double t = median(times);
+          csv << bc.name << ',' << (model == FitModel::kDipole ? "dipole" : "ddipole") << ','
+              << quality_names[q] << ',' << (model == FitModel::kDipole && analytic ? "analytic" : "automatic")
+              << ',' << t << ',' << result.chosen.samples << ',' << err_a << ',' << err_s << ',' << rms << '\n';
+          points.push_back({t, std::max(1e-7, 0.5 * (err_a + err_s)), int(series_names.size()) - 1});
+          log << "  " << series << ", " << quality_names[q] << ": " << t << " ms, sigma_a error "
+              << 100 * err_a << "%, sigma_s' error " << 100 * err_s << "%\n";
+          ++settings;
+        }
+      }
+    }
+  }
+
+  fs::create_directories(options.out_dir);
+  write_file_atomically(options.out_dir / "fit_tradeoff.csv", csv.str());
+  acquire::PlotPanel panel;
+  panel.title = "fit speed against accuracy: mean relative parameter error vs median solve time "
+                "(fast, balanced, accurate joined)";
+  panel.x_label = "time per fit (ms, log)";
+  panel.log_x = panel.log_y = true;
+  const std::array<std::array<std::uint8_t, 3>, 12> palette{
+      {{200, 30, 30}, {30, 140, 30}, {30, 60, 210}, {200, 120, 0}, {140, 0, 160}, {0, 150, 150},
+       {90, 90, 90}, {220, 0, 120}, {120, 80, 20}, {0, 90, 60}, {100, 100, 230}, {230, 160, 160}}};
+  for (std::size_t s = 0; s < series_names.size(); ++s) {
+    acquire::PlotSeries series;
+    series.rgb = palette[s % palette.size()];
+    series.line = true;
+    series.label = series_names[s];
+    for (const Point& p : points) {
+      if (p.series == int(s)) series.x.push_back(p.time_ms), series.y.push_back(p.error);
+    }
+    panel.series.push_back(series);
+  }
+  acquire::write_plot_png(options.out_dir / "fit_tradeoff.png", {panel},
+                          {"error: mean over channels of |fitted / truth - 1| for sigma_a and sigma_s', averaged",
+                           "model-made captures have an exact truth for their model; the Monte Carlo one has none"},
+                          1100, 700);
+  return settings;
+}
+
+}  // namespace lucent::fit

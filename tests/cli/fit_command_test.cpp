@@ -1,0 +1,95 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "cli_runner.h"
+
+namespace lucent::testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A dipole exitance profile written as CSV (marble red, per mm^2 per unit power entering).
+void write_csv(const fs::path& path, const std::string& body) {
+  std::ofstream(path) << body;
+}
+
+std::string good_csv() {
+  // R_d of marble's red channel at a few radii (standard dipole, eta 1.5), 2% errors.
+  return "r_mm,R,se\n"
+         "1,0.034846691737915367,0.0007\n"
+         "2,0.0090938403019244565,0.00018\n"
+         "3,0.0041478633319646276,0.000083\n"
+         "5,0.0012666925777474226,0.000025\n"
+         "8,0.00032665934632521767,0.0000065\n"
+         "10,0.00015669558811646524,0.0000031\n"
+         "15,3.478354612183064e-05,0.0000007\n"
+         "20,1.0118672506599569e-05,0.0000002\n";
+}
+
+TEST(FitCommand, FitsACsvProfileAndWritesMaterialPlotAndReport) {
+  const fs::path dir = scratch_dir("fit-good");
+  write_csv(dir / "p.csv", good_csv());
+  const auto r = run_lucent("fit \"" + (dir / "p.csv").string() + "\" --ior 1.5 --model dipole -o \"" +
+                            (dir / "m.json").string() + "\" --plot \"" + (dir / "fit.png").string() +
+                            "\" --report \"" + (dir / "report.json").string() + "\" --exclude-radius-mm 0");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir / "fit.png"));
+  EXPECT_TRUE(fs::exists(dir / "report.json"));
+  const std::string material = read_text(dir / "m.json");
+  EXPECT_NE(material.find("\"lucent-material\""), std::string::npos);
+  EXPECT_NE(material.find("\"model\": \"dipole\""), std::string::npos);
+  EXPECT_NE(material.find("\"time_ms\""), std::string::npos);
+  EXPECT_NE(material.find("\"converged\": true"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+struct BadFit {
+  const char* name;
+  std::string csv;   // written to in.csv ("" = do not write)
+  std::string args;  // {IN} and {OUT} replaced
+  const char* message;
+};
+
+void PrintTo(const BadFit& b, std::ostream* os) { *os << b.name; }
+
+class FitCommandBadInput : public ::testing::TestWithParam<BadFit> {};
+
+TEST_P(FitCommandBadInput, OneLineNonZeroExitNoOutput) {
+  const BadFit& bad = GetParam();
+  const fs::path dir = scratch_dir(std::string("fit-bad-") + bad.name);
+  const fs::path in = dir / "in.csv", out = dir / "out.json";
+  if (!bad.csv.empty()) write_csv(in, bad.csv);
+  std::string args = bad.args;
+  for (const auto& [key, value] : {std::pair{std::string("{IN}"), in.string()}, {std::string("{OUT}"), out.string()}}) {
+    for (auto pos = args.find(key); pos != std::string::npos; pos = args.find(key)) args.replace(pos, key.size(), value);
+  }
+  const auto r = run_lucent(args, bad.name);
+  EXPECT_NE(r.exit_code, 0) << bad.name;
+  EXPECT_NE(r.err.find(bad.message), std::string::npos) << bad.name << ": " << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << bad.name << ": " << r.err;
+  EXPECT_FALSE(fs::exists(out)) << bad.name;
+  fs::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, FitCommandBadInput,
+    ::testing::Values(
+        BadFit{"csv_without_ior", good_csv(), "fit {IN} -o {OUT}", "--ior"},
+        BadFit{"empty_profile", "r_mm,R,se\n", "fit {IN} --ior 1.5 -o {OUT}", "empty"},
+        BadFit{"too_few_samples", "r_mm,R,se\n1,0.03,0.001\n", "fit {IN} --ior 1.5 --exclude-radius-mm 0 -o {OUT}",
+               "usable samples"},
+        BadFit{"non_positive_values", "r_mm,R,se\n1,-0.03,0.001\n2,-0.01,0.001\n3,0,0.001\n",
+               "fit {IN} --ior 1.5 --exclude-radius-mm 0 -o {OUT}", "usable samples"},
+        BadFit{"nan_value", "r_mm,R,se\n1,nan,0.001\n2,0.01,0.001\n", "fit {IN} --ior 1.5 -o {OUT}",
+               "line 2: column R: expected a finite number"},
+        BadFit{"unknown_model", good_csv(), "fit {IN} --ior 1.5 --model tripole -o {OUT}", "--model: expected"},
+        BadFit{"bad_loss", good_csv(), "fit {IN} --ior 1.5 --loss huber:x -o {OUT}", "--loss"},
+        BadFit{"bad_quality", good_csv(), "fit {IN} --ior 1.5 --quality best -o {OUT}", "--quality"},
+        BadFit{"missing_input", "", "fit {IN} --ior 1.5 -o {OUT}", "cannot open"},
+        BadFit{"bad_header", "x,y\n1,2\n", "fit {IN} --ior 1.5 -o {OUT}", "expected a header with r_mm"}),
+    [](const ::testing::TestParamInfo<BadFit>& info) { return std::string(info.param.name); });
+
+}  // namespace
+}  // namespace lucent::testing

@@ -1,0 +1,175 @@
+// End-to-end tests of `lucent render` (cli/render_command.cpp): tiny reference renders to PNG and EXR,
+// and every kind of bad input failing with one line on stderr and no output file.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.h"
+
+namespace lucent::testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A tiny, fast reference render; append the case's own options.
+const std::string kTiny =
+    "render --technique reference --size 24x20 --samples-reference 2000 --threads 2 "
+    "--view 30,20,4 ";
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+std::string read_prefix(const fs::path& path, std::size_t n) {
+  std::ifstream in(path, std::ios::binary);
+  std::string s(n, '\0');
+  in.read(s.data(), std::streamsize(n));
+  s.resize(std::size_t(in.gcount()));
+  return s;
+}
+
+int lines(const std::string& text) { return int(std::count(text.begin(), text.end(), '\n')); }
+
+TEST(RenderCommand, ReferenceToPngWithStats) {
+  const auto dir = scratch_dir("render-png");
+  const fs::path out = dir / "sphere.png", stats = dir / "stats.json";
+  const auto r = run_lucent(kTiny + "--material marble --mesh sphere --light directional:1,1,1:2,2,2 "
+                                    "-o \"" + out.string() + "\" --stats \"" + stats.string() + "\"",
+                            "png");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  ASSERT_TRUE(fs::exists(out));
+  EXPECT_EQ(read_prefix(out, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  const auto doc = nlohmann::json::parse(read_text(stats));
+  EXPECT_EQ(doc.at("format"), "lucent-render-stats");
+  EXPECT_EQ(doc.at("version"), 1);
+  EXPECT_EQ(doc.at("technique"), "reference");
+  EXPECT_EQ(doc.at("width"), 24);
+  EXPECT_EQ(doc.at("height"), 20);
+  EXPECT_EQ(doc.at("scene").at("model"), "ddipole");  // the default for a material without one
+  EXPECT_GT(doc.at("total_ms").get<double>(), 0);
+  fs::remove_all(dir);
+}
+
+TEST(RenderCommand, ReferenceToExrWithPointLightAndDipole) {
+  const auto dir = scratch_dir("render-exr");
+  const fs::path out = dir / "sphere.exr";
+  const auto r = run_lucent(kTiny + "--material ketchup --model dipole "
+                                    "--light point:0,80,80:20000,20000,20000 -o \"" +
+                                out.string() + "\"",
+                            "exr");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_TRUE(fs::exists(out));
+  EXPECT_EQ(read_prefix(out, 4), std::string("\x76\x2f\x31\x01", 4));  // OpenEXR magic
+}
+
+TEST(RenderCommand, EnvironmentLightsTheObject) {
+  const auto dir = scratch_dir("render-env");
+  // A flat 8x4 Radiance .hdr of radiance 1 (mantissa 128, exponent 129).
+  const fs::path env = dir / "sky.hdr", out = dir / "lit.png";
+  {
+    std::ofstream f(env, std::ios::binary);
+    f << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4 +X 8\n";
+    for (int p = 0; p < 32; ++p) f << char(128) << char(128) << char(128) << char(129);
+  }
+  const auto r = run_lucent(kTiny + "--material marble --env \"" + env.string() + ":4\" -o \"" +
+                                out.string() + "\"",
+                            "env");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(out));
+  fs::remove_all(dir);
+}
+
+TEST(RenderCommand, NonManifoldMeshWarnsAndRenders) {
+  const auto dir = scratch_dir("render-open");
+  const fs::path mesh = dir / "open.obj", out = dir / "open.png";
+  write_text(mesh, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0.2\nf 1 2 3\nf 2 4 3\n");
+  const auto r = run_lucent(kTiny + "--material marble --mesh \"" + mesh.string() +
+                                "\" --light directional:0,0,1:1,1,1 -o \"" + out.string() + "\"",
+                            "open");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("warning: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("4 non-manifold edges; rendering what is there"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::exists(out));
+  fs::remove_all(dir);
+}
+
+// Each bad input: non-zero exit, exactly one line on stderr naming the problem, no output file.
+struct BadCase {
+  const char* name;
+  std::string args;       // after kTiny, before -o
+  const char* mentions;   // a word the error line must contain
+};
+
+class RenderCommandBadInput : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(RenderCommandBadInput, FailsWithOneLineAndNoOutput) {
+  const BadCase& c = GetParam();
+  const auto dir = scratch_dir(std::string("render-bad-") + c.name);
+  write_text(dir / "points.ply",
+             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+             "property float z\nelement face 0\nproperty list uchar int vertex_indices\n"
+             "end_header\n0 0 0\n1 0 0\n0 1 0\n");
+  write_text(dir / "notes.exr", "these are notes, not an image\n");
+  std::string args = c.args;
+  for (std::string::size_type at; (at = args.find("$DIR")) != std::string::npos;) {
+    args.replace(at, 4, dir.string());
+  }
+  const fs::path out = dir / "out.png";
+  const auto r = run_lucent(kTiny + args + " -o \"" + out.string() + "\"", c.name);
+  EXPECT_NE(r.exit_code, 0) << c.name;
+  EXPECT_EQ(lines(r.err), 1) << c.name << ": " << r.err;
+  EXPECT_NE(r.err.find(c.mentions), std::string::npos) << c.name << ": " << r.err;
+  EXPECT_FALSE(fs::exists(out)) << c.name;
+  fs::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, RenderCommandBadInput,
+    ::testing::Values(
+        BadCase{"unknown_mesh", "--material marble --mesh teapot --light directional:0,0,1:1,1,1",
+                "teapot"},
+        BadCase{"empty_mesh", "--material marble --mesh $DIR/points.ply "
+                              "--light directional:0,0,1:1,1,1",
+                "no triangles"},
+        BadCase{"missing_material", "--material unobtainium --light directional:0,0,1:1,1,1",
+                "unobtainium"},
+        BadCase{"no_light", "--material marble", "no light"},
+        BadCase{"zero_size", "--material marble --light directional:0,0,1:1,1,1 --size 0x0",
+                "--size"},
+        BadCase{"bad_size", "--material marble --light directional:0,0,1:1,1,1 --size 64", "--size"},
+        BadCase{"env_not_an_image", "--material marble --env $DIR/notes.exr", "notes.exr"},
+        BadCase{"bad_light", "--material marble --light directional:0,0,0:1,1,1", "--light"},
+        BadCase{"bad_model", "--material marble --light directional:0,0,1:1,1,1 --model tripole",
+                "--model"},
+        BadCase{"bad_view", "--material marble --light directional:0,0,1:1,1,1 --view 1,2",
+                "--view"},
+        BadCase{"bad_technique",
+                "--material marble --light directional:0,0,1:1,1,1 --technique raytrace",
+                "--technique"},
+        BadCase{"bad_maps_setting",
+                "--material marble --light directional:0,0,1:1,1,1 --samples 2000 --disc-points 1000",
+                "--samples"}),
+    [](const ::testing::TestParamInfo<BadCase>& info) { return std::string(info.param.name); });
+
+TEST(RenderCommand, UnsupportedOutputFormatFails) {
+  const auto dir = scratch_dir("render-tif");
+  const fs::path out = dir / "out.tif";
+  const auto r = run_lucent(kTiny + "--material marble --light directional:0,0,1:1,1,1 -o \"" +
+                                out.string() + "\"",
+                            "tif");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(lines(r.err), 1) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace lucent::testing

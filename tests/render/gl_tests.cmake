@@ -1,0 +1,14 @@
+# Tests of the OpenGL pipeline; included from tests/render/CMakeLists.txt (after lucent_add_test is
+# defined in tests/CMakeLists.txt). They skip themselves (GTEST_SKIP) where no headless OpenGL 4.5
+# context can be made. Keep renders tiny: on llvmpipe they are ~1000x slower than on a GPU.
+lucent_add_test(glsl_twin_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/glsl_twin_test.cpp
+  LIBS lucent::render lucent::materials OpenGL::OpenGL)
+lucent_add_test(radiance_maps_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/radiance_maps_test.cpp
+  LIBS lucent::render lucent::materials OpenGL::OpenGL)
+# White-box: both include headers from render/src (gl_program.h, gl_bssrdf.h,
+# radiance_maps_sampling.h).
+foreach(t glsl_twin_test radiance_maps_test)
+  target_include_directories(${t} PRIVATE ${PROJECT_SOURCE_DIR}/render/src)
+endforeach()
