@@ -7,6 +7,7 @@
 
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
+#include "lucent/materials/json_file.h"
 
 namespace lucent::acquire {
 namespace {
@@ -125,16 +126,7 @@ std::string to_string(Response response) {
 
 Capture read_capture(const std::filesystem::path& path) {
   const std::string source = path.string();
-  std::ifstream file(path);
-  if (!file) throw Error(source + ": cannot open the capture file");
-  json doc;
-  try {
-    doc = json::parse(file);
-  } catch (const json::parse_error& e) {
-    std::string what = e.what();
-    const auto colon = what.find("]: ");  // drop nlohmann's "[json.exception.parse_error.101]"
-    throw Error(source + ": not valid JSON: " + (colon != std::string::npos ? what.substr(colon + 3) : what));
-  }
+  const json doc = read_json_file(path);
   const FieldReader in(source);
   if (!doc.is_object()) throw Error(source + ": expected a JSON object (a lucent-capture file)");
   in.only_known(doc, "", {"format", "version", "images", "hdr", "pixel_pitch_mm", "incidence",

@@ -9,6 +9,7 @@
 #include "lucent/acquire/hdr_merge.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
+#include "lucent/materials/json_file.h"
 
 namespace lucent::acquire {
 namespace {
@@ -309,17 +310,7 @@ Profile profile_from_json(const json& doc, const std::string& source) {
 
 Profile read_profile(const std::filesystem::path& path) {
   const std::string source = path.string();
-  std::ifstream file(path);
-  if (!file) throw Error(source + ": cannot open the profile file");
-  json doc;
-  try {
-    doc = json::parse(file);
-  } catch (const json::parse_error& e) {
-    std::string what = e.what();
-    const auto colon = what.find("]: ");  // drop nlohmann's "[json.exception.parse_error.101]"
-    throw Error(source + ": not valid JSON: " +
-                (colon != std::string::npos ? what.substr(colon + 3) : what));
-  }
+  const json doc = read_json_file(path);
   return profile_from_json(doc, source);
 }
 

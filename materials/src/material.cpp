@@ -2,6 +2,7 @@
 // The reader accepts exactly the documented fields and rejects everything else with one line naming
 // the file, the field, what was expected and what was found (STYLE 4).
 #include "lucent/materials/material.h"
+#include "lucent/materials/json_file.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -373,7 +374,11 @@ nlohmann::json material_to_json(const Material& material) {
   return doc;
 }
 
-Material read_material(const std::filesystem::path& path) {
+}  // namespace lucent::materials
+
+namespace lucent {
+
+nlohmann::json read_json_file(const std::filesystem::path& path) {
   const std::string source = path.string();
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
@@ -387,11 +392,9 @@ Material read_material(const std::filesystem::path& path) {
   }
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) throw Error(source + ": cannot read: " + std::strerror(errno));
-
-  json doc;
   try {
-    doc = json::parse(text);
-  } catch (const json::parse_error& e) {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
     // e.what() is "[json.exception.parse_error.101] parse error at line L, column C: ...";
     // the bracketed id means nothing to a user, the position does.
     std::string what = e.what();
@@ -399,9 +402,19 @@ Material read_material(const std::filesystem::path& path) {
         !what.empty() && what[0] == '[' && end != std::string::npos) {
       what.erase(0, end + 2);
     }
-    throw Error(one_line(source + ": not valid JSON: " + what));
+    for (char& ch : what) {
+      if (ch == '\n' || ch == '\r') ch = ' ';
+    }
+    throw Error(source + ": not valid JSON: " + what);
   }
-  return material_from_json(doc, source);
+}
+
+}  // namespace lucent
+
+namespace lucent::materials {
+
+Material read_material(const std::filesystem::path& path) {
+  return material_from_json(read_json_file(path), path.string());
 }
 
 void write_material(const std::filesystem::path& path, const Material& material) {
