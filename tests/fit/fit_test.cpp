@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/directional_dipole.h"
 #include "lucent/materials/error.h"
@@ -157,6 +158,85 @@ TEST(Fit, UnconvergedFitSaysSoUnlessAllowed) {
   o.allow_unconverged = true;
   const FitResult r = fit_profiles({d}, o);
   EXPECT_FALSE(r.chosen.converged);
+}
+
+// A 2D oblique profile made by the directional dipole itself (pixel centres, no noise).
+ProfileData oblique_profile(const materials::Material& m, double incidence_deg, double azimuth_deg) {
+  ProfileData d;
+  d.source = "model-oblique";
+  d.eta = m.ior;
+  d.incidence_polar_deg = incidence_deg;
+  d.incidence_azimuth_deg = azimuth_deg;
+  const double th = incidence_deg * std::numbers::pi / 180, ph = azimuth_deg * std::numbers::pi / 180;
+  const materials::Vec3<double> w_i(-std::sin(th) * std::cos(ph), -std::sin(th) * std::sin(ph), std::cos(th));
+  const materials::Vec3<double> up(0, 0, 1);
+  const double ft = materials::fresnel_transmittance(std::cos(th), m.ior) * materials::fresnel_transmittance(1.0, m.ior);
+  Samples2d s;
+  for (int j = 0; j < 24; ++j) {
+    for (int i = 0; i < 24; ++i) {
+      const double x = (i - 11.5) * 0.5, y = (j - 11.5) * 0.5;
+      s.x_mm.push_back(x);
+      s.y_mm.push_back(y);
+      for (int c = 0; c < 3; ++c) {
+        const double v = ft * std::numbers::pi *
+                         materials::DirectionalDipole<double>(m.medium(c)).S_d(
+                             materials::Vec3<double>::Zero(), up, w_i, {x, y, 0.0}, up);
+        s.value[c].push_back(v);
+        s.standard_error[c].push_back(0.01 * v + 1e-300);
+      }
+    }
+  }
+  d.samples_2d = s;
+  return d;
+}
+
+TEST(Fit, ObliqueCapturesFitJointlyWithTheDirectionalDipole) {
+  const materials::Material m = materials::load_material("skin2");
+  FitOptions o;
+  o.model = FitModel::kAuto;
+  o.exclude_radius_mm = 0;
+  const FitResult r = fit_profiles({oblique_profile(m, 45, 0), oblique_profile(m, 30, 90)}, o);
+  EXPECT_EQ(r.chosen.model, FitModel::kDirectionalDipole) << r.reason;
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(r.chosen.channels[c].sigma_a, m.sigma_a[c], 1e-4 * m.sigma_a[c]);
+    EXPECT_NEAR(r.chosen.channels[c].sigma_s_reduced, m.sigma_s_reduced[c], 1e-4 * m.sigma_s_reduced[c]);
+    EXPECT_EQ(r.chosen.channels[c].samples, 2 * 24 * 24);
+  }
+}
+
+TEST(Fit, RobustLossShrugsOffAnOutlier) {
+  const materials::Material m = materials::load_material("marble");
+  ProfileData d = model_profile(m, FitModel::kDipole, 60);
+  for (int c = 0; c < 3; ++c) d.radial.value[c][30] *= 3.0;  // a hot pixel: 200 standard errors off
+  FitOptions o;
+  o.model = FitModel::kDipole;
+  o.exclude_radius_mm = 0;
+  const FitResult plain = fit_profiles({d}, o);
+  o.loss = LossKind::kHuber;
+  o.loss_scale = 2.0;
+  const FitResult robust = fit_profiles({d}, o);
+  for (int c = 0; c < 3; ++c) {
+    const double plain_error = std::abs(plain.chosen.channels[c].sigma_a / m.sigma_a[c] - 1);
+    const double robust_error = std::abs(robust.chosen.channels[c].sigma_a / m.sigma_a[c] - 1);
+    EXPECT_LT(robust_error, 0.2 * plain_error) << "channel " << c;
+    EXPECT_LT(robust_error, 1e-3) << "channel " << c;
+  }
+}
+
+TEST(Fit, IndexOfRefractionCanBeFitted) {
+  // The ddipole's shape at oblique incidence depends on eta (refraction of the beam, C_phi, C_E): a
+  // noise-free oblique profile pins it.
+  const materials::Material m = materials::load_material("apple");
+  FitOptions o;
+  o.model = FitModel::kDirectionalDipole;
+  o.exclude_radius_mm = 0;
+  o.fit_ior = true;
+  o.ior = 1.45;  // start away from the truth, 1.3
+  ProfileData d = oblique_profile(m, 50, 0);
+  d.eta.reset();
+  const FitResult r = fit_profiles({d}, o);
+  EXPECT_NEAR(r.chosen.eta, 1.3, 1e-3);
+  EXPECT_GT(r.chosen.sd_eta, 0.0);
 }
 
 TEST(Fit, BadInputs) {
