@@ -26,22 +26,33 @@ struct FitArguments {
 
 fit::FitOptions to_options(const FitArguments& a) {
   fit::FitOptions o;
-  if (a.model == "dipole") o.model = fit::FitModel::kDipole;
-  else if (a.model == "ddipole") o.model = fit::FitModel::kDirectionalDipole;
-  else if (a.model == "auto") o.model = fit::FitModel::kAuto;
-  else throw Error("--model: expected dipole, ddipole or auto, got '" + a.model + "'");
-  if (a.quality == "fast") o.quality = fit::Quality::kFast;
-  else if (a.quality == "balanced") o.quality = fit::Quality::kBalanced;
-  else if (a.quality == "accurate") o.quality = fit::Quality::kAccurate;
-  else throw Error("--quality: expected fast, balanced or accurate, got '" + a.quality + "'");
+  if (a.model == "dipole")
+    o.model = fit::FitModel::kDipole;
+  else if (a.model == "ddipole")
+    o.model = fit::FitModel::kDirectionalDipole;
+  else if (a.model == "auto")
+    o.model = fit::FitModel::kAuto;
+  else
+    throw Error("--model: expected dipole, ddipole or auto, got '" + a.model + "'");
+  if (a.quality == "fast")
+    o.quality = fit::Quality::kFast;
+  else if (a.quality == "balanced")
+    o.quality = fit::Quality::kBalanced;
+  else if (a.quality == "accurate")
+    o.quality = fit::Quality::kAccurate;
+  else
+    throw Error("--quality: expected fast, balanced or accurate, got '" + a.quality + "'");
   if (a.loss == "none") {
     o.loss = fit::LossKind::kNone;
   } else {
     const auto colon = a.loss.find(':');
     const std::string kind = a.loss.substr(0, colon);
-    if (kind == "huber") o.loss = fit::LossKind::kHuber;
-    else if (kind == "cauchy") o.loss = fit::LossKind::kCauchy;
-    else throw Error("--loss: expected none, huber:S or cauchy:S, got '" + a.loss + "'");
+    if (kind == "huber")
+      o.loss = fit::LossKind::kHuber;
+    else if (kind == "cauchy")
+      o.loss = fit::LossKind::kCauchy;
+    else
+      throw Error("--loss: expected none, huber:S or cauchy:S, got '" + a.loss + "'");
     if (colon != std::string::npos) {
       try {
         o.loss_scale = std::stod(a.loss.substr(colon + 1));
@@ -91,7 +102,8 @@ void run(const FitArguments& a) {
     return;
   }
   const char* names[3] = {"R", "G", "B"};
-  std::cout << "fitted " << (f.model == fit::FitModel::kDipole ? "standard dipole" : "directional dipole")
+  std::cout << "fitted "
+            << (f.model == fit::FitModel::kDipole ? "standard dipole" : "directional dipole")
             << " (" << result.reason << ")\n";
   for (int c = 0; c < 3; ++c) {
     if (f.channels[c].samples == 0) continue;
@@ -108,26 +120,32 @@ void run(const FitArguments& a) {
 
 void register_fit_command(CLI::App& app) {
   auto args = std::make_shared<FitArguments>();
-  CLI::App* cmd = app.add_subcommand(
-      "fit",
-      "Fit the standard or directional dipole to measured profiles (lucent-profile JSON from lucent "
-      "acquire, or CSV with r_mm and R or R_r,R_g,R_b per mm^2 and optional se columns) and write a "
-      "material file. Several profiles of one material are fitted jointly.");
+  CLI::App* cmd =
+      app.add_subcommand("fit",
+                         "Fit the standard or directional dipole to measured profiles "
+                         "(lucent-profile JSON from lucent "
+                         "acquire, or CSV with r_mm and R or R_r,R_g,R_b per mm^2 and optional se "
+                         "columns) and write a "
+                         "material file. Several profiles of one material are fitted jointly.");
   cmd->add_option("inputs", args->inputs, "profile files (.json or .csv)")->required();
   cmd->add_option("-o,--output", args->output, "material file to write (.json)")->required();
-  cmd->add_option("--model", args->model, "dipole, ddipole or auto (simplest the data does not reject)")
+  cmd->add_option("--model", args->model,
+                  "dipole, ddipole or auto (simplest the data does not reject)")
       ->capture_default_str();
-  cmd->add_option("--exclude-radius-mm", args->exclude_radius_mm,
-                  "leave out samples closer to the entry point than this, mm (default: one transport "
-                  "mean free path, estimated)");
-  cmd->add_option("--ior", args->ior, "relative index of refraction of the sample (required with CSV)");
+  cmd->add_option(
+      "--exclude-radius-mm", args->exclude_radius_mm,
+      "leave out samples closer to the entry point than this, mm (default: one transport "
+      "mean free path, estimated)");
+  cmd->add_option("--ior", args->ior,
+                  "relative index of refraction of the sample (required with CSV)");
   cmd->add_flag("--fit-ior", args->fit_ior, "fit the index too (one for all channels)");
   cmd->add_flag("--relative", args->relative,
                 "fit a global scale (automatic when the profile says it is relative)");
   cmd->add_option("--loss", args->loss, "none, huber:S or cauchy:S (S in standard errors)")
       ->capture_default_str();
-  cmd->add_option("--quality", args->quality,
-                  "fast, balanced or accurate: footprint quadrature order, samples used, tolerances")
+  cmd->add_option(
+         "--quality", args->quality,
+         "fast, balanced or accurate: footprint quadrature order, samples used, tolerances")
       ->capture_default_str();
   cmd->add_option("--plot", args->plot, "write the fit plot (PNG)");
   cmd->add_option("--report", args->report, "write everything per channel (JSON)");

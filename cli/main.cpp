@@ -6,9 +6,10 @@
 #include "lucent/version.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"lucent: measure translucent materials and show them.\n"
-               "Lengths in mm, coefficients in mm^-1 unless an option says otherwise.",
-               "lucent"};
+  CLI::App app{
+      "lucent: measure translucent materials and show them.\n"
+      "Lengths in mm, coefficients in mm^-1 unless an option says otherwise.",
+      "lucent"};
   app.set_version_flag("--version", std::string("lucent ") + lucent::kVersion);
   app.require_subcommand(1);
   app.fallthrough(false);

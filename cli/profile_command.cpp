@@ -37,8 +37,8 @@ void run_profile(const ProfileArguments& args) {
     RadialProfileOptions options;
     options.model = model;
     options.total = args.total;
-    options.r_mm = !args.radii.empty() ? parse_radius_list(args.radii)
-                                       : parse_radius_range(args.radius_range);
+    options.r_mm =
+        !args.radii.empty() ? parse_radius_list(args.radii) : parse_radius_range(args.radius_range);
     csv = radial_profile_csv(material, options);
   }
   if (args.output.empty() || args.output == "-") {

@@ -61,14 +61,21 @@ std::vector<double> parse_exposures(const std::string& text) {
 void run(SimulateArguments& args) {
   acquire::SimulateOptions& o = args.options;
   o.material = materials::load_material(args.material);
-  if (args.response == "srgb") o.camera.response = acquire::Response::kSrgb;
-  else if (args.response == "linear") o.camera.response = acquire::Response::kLinear;
-  else throw Error("--response: expected 'srgb' or 'linear', got '" + args.response + "'");
+  if (args.response == "srgb")
+    o.camera.response = acquire::Response::kSrgb;
+  else if (args.response == "linear")
+    o.camera.response = acquire::Response::kLinear;
+  else
+    throw Error("--response: expected 'srgb' or 'linear', got '" + args.response + "'");
   o.camera.exposures_s = parse_exposures(args.exposures);
-  if (args.source == "montecarlo") o.source = acquire::RadianceSource::kMonteCarlo;
-  else if (args.source == "dipole") o.source = acquire::RadianceSource::kDipole;
-  else if (args.source == "ddipole") o.source = acquire::RadianceSource::kDirectionalDipole;
-  else throw Error("--source: expected montecarlo, dipole or ddipole, got '" + args.source + "'");
+  if (args.source == "montecarlo")
+    o.source = acquire::RadianceSource::kMonteCarlo;
+  else if (args.source == "dipole")
+    o.source = acquire::RadianceSource::kDipole;
+  else if (args.source == "ddipole")
+    o.source = acquire::RadianceSource::kDirectionalDipole;
+  else
+    throw Error("--source: expected montecarlo, dipole or ddipole, got '" + args.source + "'");
   o.camera.noise = !args.no_noise;
   o.white_reference = !args.no_white;
   o.dark_frame = !args.no_dark;
@@ -88,8 +95,10 @@ void run(SimulateArguments& args) {
 
   const auto& t = summary.transport;
   if (args.json) {
-    nlohmann::json j = {{"output", args.output}, {"files", summary.files},
-                        {"wall_seconds", t.wall_seconds}, {"threads", t.threads_used},
+    nlohmann::json j = {{"output", args.output},
+                        {"files", summary.files},
+                        {"wall_seconds", t.wall_seconds},
+                        {"threads", t.threads_used},
                         {"camera_scale", summary.camera_scale}};
     for (int c = 0; c < 3; ++c) {
       j["diffuse_reflectance"].push_back(t.channels[c].diffuse_reflectance.value);
@@ -120,41 +129,60 @@ void register_simulate_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "simulate",
       "Virtual capture rig: Monte Carlo photon transport in a slab (Henyey-Greenstein phase, "
-      "Fresnel boundary) lit by a pencil beam of unit power, imaged by a camera model into exposure "
+      "Fresnel boundary) lit by a pencil beam of unit power, imaged by a camera model into "
+      "exposure "
       "brackets with a white reference and a dark frame. Writes OUTDIR/capture.json for lucent "
       "acquire, the bracket PNGs, truth.json and truth_radiance.exr (mm^-2 sr^-1 per unit power).");
-  cmd->add_option("--material", args->material, "bundled material name or material file")->required();
-  cmd->add_option("-o,--output", args->output, "output folder (created; written atomically)")->required();
+  cmd->add_option("--material", args->material, "bundled material name or material file")
+      ->required();
+  cmd->add_option("-o,--output", args->output, "output folder (created; written atomically)")
+      ->required();
   cmd->add_option("--source", args->source,
                   "exit radiance from montecarlo (photon transport), or from the dipole / ddipole "
-                  "model (for round trips of lucent fit)")->capture_default_str();
-  cmd->add_option("--photons", o.transport.photons, "photons per colour channel")->capture_default_str();
+                  "model (for round trips of lucent fit)")
+      ->capture_default_str();
+  cmd->add_option("--photons", o.transport.photons, "photons per colour channel")
+      ->capture_default_str();
   cmd->add_option("--seed", o.transport.seed, "random seed (results identical for any --threads)")
       ->capture_default_str();
-  cmd->add_option("--threads", o.transport.threads, "worker threads (0 = all cores)")->capture_default_str();
+  cmd->add_option("--threads", o.transport.threads, "worker threads (0 = all cores)")
+      ->capture_default_str();
   cmd->add_option("--thickness-mm", o.transport.thickness_mm,
                   "slab thickness in mm (default: semi-infinite)");
   cmd->add_option("--incidence-deg", o.transport.incidence_deg,
-                  "beam angle from the normal, degrees [0, 90)")->capture_default_str();
+                  "beam angle from the normal, degrees [0, 90)")
+      ->capture_default_str();
   cmd->add_option("--azimuth-deg", o.transport.azimuth_deg,
-                  "beam direction of travel in the image plane, degrees from +x")->capture_default_str();
+                  "beam direction of travel in the image plane, degrees from +x")
+      ->capture_default_str();
   cmd->add_option("--view-deg", o.transport.view_deg,
-                  "camera angle from the normal, degrees [0, 90)")->capture_default_str();
+                  "camera angle from the normal, degrees [0, 90)")
+      ->capture_default_str();
   cmd->add_option("--view-azimuth-deg", o.transport.view_azimuth_deg,
-                  "camera azimuth, degrees from +x")->capture_default_str();
-  cmd->add_option("--size", o.transport.size, "image width and height, pixels")->capture_default_str();
-  cmd->add_option("--pixel-mm", o.transport.pixel_mm, "pixel pitch on the sample, mm")->capture_default_str();
+                  "camera azimuth, degrees from +x")
+      ->capture_default_str();
+  cmd->add_option("--size", o.transport.size, "image width and height, pixels")
+      ->capture_default_str();
+  cmd->add_option("--pixel-mm", o.transport.pixel_mm, "pixel pitch on the sample, mm")
+      ->capture_default_str();
   cmd->add_option("--max-radius-mm", o.transport.max_radius_mm,
-                  "outer radius of the radial exitance table, mm")->capture_default_str();
-  cmd->add_option("--exposures", args->exposures, "exposure times in s, increasing")->capture_default_str();
-  cmd->add_option("--response", args->response, "camera encoding: srgb or linear")->capture_default_str();
+                  "outer radius of the radial exitance table, mm")
+      ->capture_default_str();
+  cmd->add_option("--exposures", args->exposures, "exposure times in s, increasing")
+      ->capture_default_str();
+  cmd->add_option("--response", args->response, "camera encoding: srgb or linear")
+      ->capture_default_str();
   cmd->add_option("--bits", o.camera.bits, "bits per channel: 8 or 16")->capture_default_str();
-  cmd->add_option("--full-well-e", o.camera.full_well_e, "electrons at saturation")->capture_default_str();
-  cmd->add_option("--read-noise-e", o.camera.read_noise_e, "read noise, electrons rms")->capture_default_str();
-  cmd->add_option("--black-level-e", o.camera.black_level_e, "pedestal, electrons")->capture_default_str();
+  cmd->add_option("--full-well-e", o.camera.full_well_e, "electrons at saturation")
+      ->capture_default_str();
+  cmd->add_option("--read-noise-e", o.camera.read_noise_e, "read noise, electrons rms")
+      ->capture_default_str();
+  cmd->add_option("--black-level-e", o.camera.black_level_e, "pedestal, electrons")
+      ->capture_default_str();
   cmd->add_option("--camera-scale", o.camera.electrons_per_radiance_s,
                   "electrons per (radiance x s); 0 = brightest pixel half-fills the well at the "
-                  "shortest exposure")->capture_default_str();
+                  "shortest exposure")
+      ->capture_default_str();
   cmd->add_flag("--no-noise", args->no_noise, "noise-free camera (exact expected values)");
   cmd->add_flag("--no-white-reference", args->no_white, "do not image the white reference");
   cmd->add_flag("--no-dark", args->no_dark, "do not take a dark frame");

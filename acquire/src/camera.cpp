@@ -30,7 +30,8 @@ double srgb_decode(double v) {
 
 double camera_scale(const CameraOptions& options, double peak_radiance) {
   if (options.electrons_per_radiance_s > 0) return options.electrons_per_radiance_s;
-  if (!(peak_radiance > 0)) throw Error("camera: the image is black, no exposure scale can be chosen");
+  if (!(peak_radiance > 0))
+    throw Error("camera: the image is black, no exposure scale can be chosen");
   if (options.exposures_s.empty()) throw Error("--exposures: expected at least one exposure time");
   return options.auto_fill * (options.full_well_e - options.black_level_e) /
          (peak_radiance * options.exposures_s.front());

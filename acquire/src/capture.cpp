@@ -117,9 +117,12 @@ json image_set_to_json(const ImageSet& set) {
 
 std::string to_string(Response response) {
   switch (response) {
-    case Response::kLinear: return "linear";
-    case Response::kSrgb: return "srgb";
-    case Response::kCalibrate: return "calibrate";
+    case Response::kLinear:
+      return "linear";
+    case Response::kSrgb:
+      return "srgb";
+    case Response::kCalibrate:
+      return "calibrate";
   }
   return "linear";
 }
@@ -129,9 +132,10 @@ Capture read_capture(const std::filesystem::path& path) {
   const json doc = read_json_file(path);
   const FieldReader in(source);
   if (!doc.is_object()) throw Error(source + ": expected a JSON object (a lucent-capture file)");
-  in.only_known(doc, "", {"format", "version", "images", "hdr", "pixel_pitch_mm", "incidence",
-                          "view_deg", "ior", "beam_point_px", "response", "dark", "white_reference",
-                          "beam_power", "provenance"});
+  in.only_known(
+      doc, "",
+      {"format", "version", "images", "hdr", "pixel_pitch_mm", "incidence", "view_deg", "ior",
+       "beam_point_px", "response", "dark", "white_reference", "beam_power", "provenance"});
   if (!doc.contains("format")) in.fail("format", "missing (expected \"lucent-capture\")");
   if (doc["format"] != "lucent-capture") {
     in.fail("format", "expected \"lucent-capture\", found " + doc["format"].dump());
@@ -139,18 +143,21 @@ Capture read_capture(const std::filesystem::path& path) {
   if (!doc.contains("version") || !doc["version"].is_number_integer()) {
     in.fail("version", "expected the integer 1");
   }
-  if (doc["version"].get<long long>() > Capture::kFormatVersion || doc["version"].get<long long>() < 1) {
+  if (doc["version"].get<long long>() > Capture::kFormatVersion ||
+      doc["version"].get<long long>() < 1) {
     in.fail("version", "this lucent reads capture version 1, found " + doc["version"].dump());
   }
 
   Capture c;
   c.base_dir = path.parent_path();
   c.sample = read_image_set(doc, "", in);
-  if (!doc.contains("pixel_pitch_mm")) in.fail("pixel_pitch_mm", "missing (pixel size on the sample in mm)");
+  if (!doc.contains("pixel_pitch_mm"))
+    in.fail("pixel_pitch_mm", "missing (pixel size on the sample in mm)");
   c.pixel_pitch_mm = in.number(doc["pixel_pitch_mm"], "pixel_pitch_mm");
   if (!(c.pixel_pitch_mm > 0)) in.fail("pixel_pitch_mm", "expected a pixel pitch > 0 mm");
 
-  if (!doc.contains("incidence")) in.fail("incidence", "missing (expected {\"polar_deg\", \"azimuth_deg\"})");
+  if (!doc.contains("incidence"))
+    in.fail("incidence", "missing (expected {\"polar_deg\", \"azimuth_deg\"})");
   const json& incidence = in.object(doc["incidence"], "incidence");
   in.only_known(incidence, "incidence.", {"polar_deg", "azimuth_deg"});
   if (!incidence.contains("polar_deg")) in.fail("incidence.polar_deg", "missing");
@@ -177,10 +184,14 @@ Capture read_capture(const std::filesystem::path& path) {
   }
   if (doc.contains("response")) {
     const std::string r = in.string(doc["response"], "response");
-    if (r == "linear") c.response = Response::kLinear;
-    else if (r == "srgb") c.response = Response::kSrgb;
-    else if (r == "calibrate") c.response = Response::kCalibrate;
-    else in.fail("response", "expected \"linear\", \"srgb\" or \"calibrate\", found \"" + r + "\"");
+    if (r == "linear")
+      c.response = Response::kLinear;
+    else if (r == "srgb")
+      c.response = Response::kSrgb;
+    else if (r == "calibrate")
+      c.response = Response::kCalibrate;
+    else
+      in.fail("response", "expected \"linear\", \"srgb\" or \"calibrate\", found \"" + r + "\"");
   }
   if (doc.contains("dark")) c.dark = in.string(doc["dark"], "dark");
   if (doc.contains("white_reference")) {
@@ -210,7 +221,8 @@ json capture_to_json(const Capture& c) {
   const json set = image_set_to_json(c.sample);
   for (const auto& [key, value] : set.items()) doc[key] = value;
   doc["pixel_pitch_mm"] = c.pixel_pitch_mm;
-  doc["incidence"] = {{"polar_deg", c.incidence_polar_deg}, {"azimuth_deg", c.incidence_azimuth_deg}};
+  doc["incidence"] = {{"polar_deg", c.incidence_polar_deg},
+                      {"azimuth_deg", c.incidence_azimuth_deg}};
   doc["view_deg"] = c.view_deg;
   if (c.ior) doc["ior"] = *c.ior;
   if (c.beam_point_px) doc["beam_point_px"] = {(*c.beam_point_px)[0], (*c.beam_point_px)[1]};

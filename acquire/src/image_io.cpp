@@ -1,12 +1,12 @@
 #include "lucent/acquire/image_io.h"
 
+#include <Iex.h>
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
-#include <Iex.h>
 
 #include <algorithm>
 #include <opencv2/imgcodecs.hpp>
@@ -18,7 +18,8 @@
 namespace lucent::acquire {
 
 ImageRgb read_exr(const std::filesystem::path& path) {
-  if (!std::filesystem::exists(path)) throw Error(path.string() + ": no such file (expected an OpenEXR image)");
+  if (!std::filesystem::exists(path))
+    throw Error(path.string() + ": no such file (expected an OpenEXR image)");
   try {
     Imf::InputFile file(path.c_str());
     const Imath::Box2i window = file.header().dataWindow();
@@ -26,9 +27,11 @@ ImageRgb read_exr(const std::filesystem::path& path) {
     const int height = window.max.y - window.min.y + 1;
     if (width <= 0 || height <= 0) throw Error(path.string() + ": empty OpenEXR image");
     const Imf::ChannelList& channels = file.header().channels();
-    const bool rgb = channels.findChannel("R") && channels.findChannel("G") && channels.findChannel("B");
+    const bool rgb =
+        channels.findChannel("R") && channels.findChannel("G") && channels.findChannel("B");
     const bool grey = channels.findChannel("Y") != nullptr;
-    if (!rgb && !grey) throw Error(path.string() + ": OpenEXR image has neither R, G, B nor Y channels");
+    if (!rgb && !grey)
+      throw Error(path.string() + ": OpenEXR image has neither R, G, B nor Y channels");
     ImageRgb image(width, height);
     Imf::FrameBuffer frame;
     const std::size_t xs = sizeof(float) * 3, ys = xs * width;
@@ -53,12 +56,14 @@ ImageRgb read_exr(const std::filesystem::path& path) {
 
 void write_exr(const std::filesystem::path& path, const ImageRgb& image,
                const std::map<std::string, std::string>& attributes) {
-  if (image.width <= 0 || image.height <= 0) throw Error(path.string() + ": refusing to write an empty image");
+  if (image.width <= 0 || image.height <= 0)
+    throw Error(path.string() + ": refusing to write an empty image");
   AtomicOutputPath out(path);
   try {
     Imf::Header header(image.width, image.height);
     header.compression() = Imf::ZIP_COMPRESSION;
-    for (const char* name : {"R", "G", "B"}) header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+    for (const char* name : {"R", "G", "B"})
+      header.channels().insert(name, Imf::Channel(Imf::FLOAT));
     for (const auto& [key, value] : attributes) header.insert(key, Imf::StringAttribute(value));
     Imf::OutputFile file(out.temporary().c_str(), header);
     Imf::FrameBuffer frame;
@@ -81,21 +86,32 @@ RawImage read_raw_image(const std::filesystem::path& path) {
   const cv::Mat mat = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
   if (mat.empty()) throw Error(path.string() + ": cannot read as an image (expected PNG or TIFF)");
   int max_value = 0;
-  if (mat.depth() == CV_8U) max_value = 255;
-  else if (mat.depth() == CV_16U) max_value = 65535;
-  else throw Error(path.string() + ": expected 8- or 16-bit integer pixels");
+  if (mat.depth() == CV_8U)
+    max_value = 255;
+  else if (mat.depth() == CV_16U)
+    max_value = 65535;
+  else
+    throw Error(path.string() + ": expected 8- or 16-bit integer pixels");
   cv::Mat rgb;
   switch (mat.channels()) {
-    case 1: cv::cvtColor(mat, rgb, cv::COLOR_GRAY2RGB); break;
-    case 3: cv::cvtColor(mat, rgb, cv::COLOR_BGR2RGB); break;
-    case 4: cv::cvtColor(mat, rgb, cv::COLOR_BGRA2RGB); break;
-    default: throw Error(path.string() + ": expected 1, 3 or 4 channels");
+    case 1:
+      cv::cvtColor(mat, rgb, cv::COLOR_GRAY2RGB);
+      break;
+    case 3:
+      cv::cvtColor(mat, rgb, cv::COLOR_BGR2RGB);
+      break;
+    case 4:
+      cv::cvtColor(mat, rgb, cv::COLOR_BGRA2RGB);
+      break;
+    default:
+      throw Error(path.string() + ": expected 1, 3 or 4 channels");
   }
   RawImage image(rgb.cols, rgb.rows, max_value);
   for (int y = 0; y < rgb.rows; ++y) {
     for (int x = 0; x < rgb.cols; ++x) {
       for (int c = 0; c < 3; ++c) {
-        image.at(x, y, c) = max_value == 255 ? rgb.at<cv::Vec3b>(y, x)[c] : rgb.at<cv::Vec3w>(y, x)[c];
+        image.at(x, y, c) =
+            max_value == 255 ? rgb.at<cv::Vec3b>(y, x)[c] : rgb.at<cv::Vec3w>(y, x)[c];
       }
     }
   }
@@ -111,8 +127,10 @@ void write_png(const std::filesystem::path& path, const RawImage& image) {
   for (int y = 0; y < image.height; ++y) {
     for (int x = 0; x < image.width; ++x) {
       for (int c = 0; c < 3; ++c) {  // OpenCV stores BGR
-        if (eight) mat.at<cv::Vec3b>(y, x)[2 - c] = static_cast<std::uint8_t>(image.at(x, y, c));
-        else mat.at<cv::Vec3w>(y, x)[2 - c] = image.at(x, y, c);
+        if (eight)
+          mat.at<cv::Vec3b>(y, x)[2 - c] = static_cast<std::uint8_t>(image.at(x, y, c));
+        else
+          mat.at<cv::Vec3w>(y, x)[2 - c] = image.at(x, y, c);
       }
     }
   }
@@ -129,11 +147,13 @@ void write_png(const std::filesystem::path& path, const RawImage& image) {
 
 ImageRgb read_any_image(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return std::tolower(ch); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char ch) { return std::tolower(ch); });
   if (ext == ".exr") return read_exr(path);
   const RawImage raw = read_raw_image(path);
   ImageRgb image(raw.width, raw.height);
-  for (std::size_t i = 0; i < raw.data.size(); ++i) image.data[i] = float(raw.data[i]) / raw.max_value;
+  for (std::size_t i = 0; i < raw.data.size(); ++i)
+    image.data[i] = float(raw.data[i]) / raw.max_value;
   return image;
 }
 

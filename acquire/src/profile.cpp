@@ -393,8 +393,8 @@ RadialProfile bin_radial_profile(const HdrResult& hdr, const std::array<double, 
   const std::vector<double> edges = radial_bin_edges_mm(binning, pixel_pitch_mm);
   const std::size_t bins = edges.size() - 1;
   // Per bin and channel: the pixels' (r, value) for a scatter about the bin's own linear trend in r
-  // (the profile falls across a bin; scatter about the plain mean would count that fall as noise and
-  // overstate the error several times), and the propagated per-pixel errors.
+  // (the profile falls across a bin; scatter about the plain mean would count that fall as noise
+  // and overstate the error several times), and the propagated per-pixel errors.
   struct Accumulator {
     std::int64_t n = 0;
     double mean = 0, m2 = 0, se2 = 0;

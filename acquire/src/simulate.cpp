@@ -5,11 +5,11 @@
 #include <sstream>
 
 #include "lucent/acquire/image_io.h"
+#include "lucent/materials/atomic_file.h"
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/directional_dipole.h"
-#include "lucent/materials/fresnel.h"
-#include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
+#include "lucent/materials/fresnel.h"
 #include "lucent/version.h"
 
 namespace lucent::acquire {
@@ -38,24 +38,29 @@ double peak(const ImageRgb& image) {
 }
 
 json transport_to_json(const PhotonTransportOptions& o) {
-  return {{"thickness_mm", std::isfinite(o.thickness_mm) ? json(o.thickness_mm) : json("infinite")},
-          {"incidence_deg", o.incidence_deg},
-          {"azimuth_deg", o.azimuth_deg},
-          {"photons_per_channel", o.photons},
-          {"seed", o.seed},
-          {"max_radius_mm", o.max_radius_mm},
-          {"size_px", o.size},
-          {"pixel_mm", o.pixel_mm},
-          {"view_deg", o.view_deg},
-          {"view_azimuth_deg", o.view_azimuth_deg},
-          {"boundary_scoring", o.boundary_scoring == BoundaryScoring::kSplit ? "split" : "stochastic"}};
+  return {
+      {"thickness_mm", std::isfinite(o.thickness_mm) ? json(o.thickness_mm) : json("infinite")},
+      {"incidence_deg", o.incidence_deg},
+      {"azimuth_deg", o.azimuth_deg},
+      {"photons_per_channel", o.photons},
+      {"seed", o.seed},
+      {"max_radius_mm", o.max_radius_mm},
+      {"size_px", o.size},
+      {"pixel_mm", o.pixel_mm},
+      {"view_deg", o.view_deg},
+      {"view_azimuth_deg", o.view_azimuth_deg},
+      {"boundary_scoring", o.boundary_scoring == BoundaryScoring::kSplit ? "split" : "stochastic"}};
 }
 
 json camera_to_json(const CameraOptions& o, double scale) {
-  return {{"exposures_s", o.exposures_s},     {"response", to_string(o.response)},
-          {"bits", o.bits},                   {"full_well_e", o.full_well_e},
-          {"read_noise_e", o.read_noise_e},   {"black_level_e", o.black_level_e},
-          {"noise", o.noise},                 {"electrons_per_radiance_s", scale},
+  return {{"exposures_s", o.exposures_s},
+          {"response", to_string(o.response)},
+          {"bits", o.bits},
+          {"full_well_e", o.full_well_e},
+          {"read_noise_e", o.read_noise_e},
+          {"black_level_e", o.black_level_e},
+          {"noise", o.noise},
+          {"electrons_per_radiance_s", scale},
           {"seed", o.seed}};
 }
 
@@ -88,14 +93,15 @@ ImageRgb model_radiance(const materials::Material& material, RadianceSource sour
                         const PhotonTransportOptions& g) {
   constexpr double kDegree = std::numbers::pi / 180;
   const double theta = g.incidence_deg * kDegree, phi = g.azimuth_deg * kDegree;
-  const materials::Vec3<double> w_i(-std::sin(theta) * std::cos(phi), -std::sin(theta) * std::sin(phi),
-                                    std::cos(theta));
+  const materials::Vec3<double> w_i(-std::sin(theta) * std::cos(phi),
+                                    -std::sin(theta) * std::sin(phi), std::cos(theta));
   const materials::Vec3<double> up(0, 0, 1);
   ImageRgb image(g.size, g.size);
   for (int c = 0; c < 3; ++c) {
     const materials::Medium<double> medium = material.medium(c);
-    const double fresnel = materials::fresnel_transmittance(std::cos(theta), medium.eta) *
-                           materials::fresnel_transmittance(std::cos(g.view_deg * kDegree), medium.eta);
+    const double fresnel =
+        materials::fresnel_transmittance(std::cos(theta), medium.eta) *
+        materials::fresnel_transmittance(std::cos(g.view_deg * kDegree), medium.eta);
     const materials::StandardDipole<double> dipole(medium);
     const materials::DirectionalDipole<double> dd(medium);
     const auto S = [&](double x, double y) {
@@ -111,7 +117,8 @@ ImageRgb model_radiance(const materials::Material& material, RadianceSource sour
         const int n = centre ? 16 : 4;
         double sum = 0;
         for (int a = 0; a < n; ++a) {
-          for (int b = 0; b < n; ++b) sum += S(x0 + (a + 0.5) / n * g.pixel_mm, y0 + (b + 0.5) / n * g.pixel_mm);
+          for (int b = 0; b < n; ++b)
+            sum += S(x0 + (a + 0.5) / n * g.pixel_mm, y0 + (b + 0.5) / n * g.pixel_mm);
         }
         image.at(i, j, c) = float(fresnel * sum / (n * n));
       }
@@ -152,7 +159,8 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
         throw Error("--exposures: exposure times must increase strictly");
       }
     }
-    if (options.camera.bits != 8 && options.camera.bits != 16) throw Error("--bits: expected 8 or 16");
+    if (options.camera.bits != 8 && options.camera.bits != 16)
+      throw Error("--bits: expected 8 or 16");
   }
   validate_photon_transport_options(transport);
   AtomicOutputDir out(out_dir);  // checks the folder can be made before the long simulation
@@ -170,21 +178,24 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
   json truth = {{"format", "lucent-simulation-truth"},
                 {"version", 1},
                 {"material", materials::material_to_json(options.material)},
-                {"source", monte_carlo ? "montecarlo"
-                           : options.source == RadianceSource::kDipole ? "dipole" : "ddipole"},
+                {"source", monte_carlo                                 ? "montecarlo"
+                           : options.source == RadianceSource::kDipole ? "dipole"
+                                                                       : "ddipole"},
                 {"transport", transport_to_json(transport)},
                 {"tool", std::string("lucent simulate ") + kVersion}};
   if (monte_carlo) {
     truth["totals"] = totals_to_json(result);
     truth["mean_interactions"] = json::array();
-    for (const auto& ch : result.channels) truth["mean_interactions"].push_back(ch.mean_interactions);
+    for (const auto& ch : result.channels)
+      truth["mean_interactions"].push_back(ch.mean_interactions);
     truth["wall_seconds"] = result.wall_seconds;
     truth["threads_used"] = result.threads_used;
   }
 
   if (!options.profile_only) {
-    const ImageRgb radiance = monte_carlo ? to_image(result, false)
-                                          : model_radiance(options.material, options.source, transport);
+    const ImageRgb radiance = monte_carlo
+                                  ? to_image(result, false)
+                                  : model_radiance(options.material, options.source, transport);
     const double pixel_area = transport.pixel_mm * transport.pixel_mm;
     const double scale = camera_scale(options.camera, peak(radiance));
     summary.camera_scale = scale;
@@ -204,8 +215,8 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
     capture.view_deg = transport.view_deg;
     capture.ior = options.material.ior;
     // At oblique incidence the light emerges ahead of the entry point, so the brightest region no
-    // longer marks it; a real rig marks it (the specular glint, a fiducial). The simulator knows it:
-    // the corner between the four middle pixels.
+    // longer marks it; a real rig marks it (the specular glint, a fiducial). The simulator knows
+    // it: the corner between the four middle pixels.
     if (transport.incidence_deg > 0) {
       capture.beam_point_px = std::array<double, 2>{transport.size / 2.0, transport.size / 2.0};
     }
@@ -220,7 +231,8 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
     }
     json white_json = nullptr;
     if (options.white_reference) {
-      const double sigma = options.white_spot_sigma_mm > 0 ? options.white_spot_sigma_mm : transport.pixel_mm;
+      const double sigma =
+          options.white_spot_sigma_mm > 0 ? options.white_spot_sigma_mm : transport.pixel_mm;
       const ImageRgb white = white_reference_radiance(transport.size, transport.pixel_mm,
                                                       options.white_reflectance, sigma);
       // The reference is far brighter than the sample: shorten its exposures by a power of two so
@@ -237,7 +249,8 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
         summary.files.push_back(name);
       }
       capture.white_reference = reference;
-      white_json = {{"reflectance", options.white_reflectance}, {"spot_sigma_mm", sigma},
+      white_json = {{"reflectance", options.white_reflectance},
+                    {"spot_sigma_mm", sigma},
                     {"exposure_divisor", shorten}};
     }
     if (options.dark_frame) {
@@ -259,7 +272,8 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
   write_file_atomically(out.temporary() / "truth.json", truth.dump(2) + "\n");
   summary.files.push_back("truth.json");
   out.commit();
-  if (options.exitance_csv && monte_carlo) write_file_atomically(*options.exitance_csv, exitance_csv(result));
+  if (options.exitance_csv && monte_carlo)
+    write_file_atomically(*options.exitance_csv, exitance_csv(result));
   return summary;
 }
 

@@ -11,7 +11,7 @@
 namespace lucent::fit::detail {
 
 struct DipoleGradient {
-  double value = 0;         ///< R_d, mm^-2
+  double value = 0;          ///< R_d, mm^-2
   double d_log_sigma_a = 0;  ///< dR_d / d log sigma_a
   double d_log_sigma_s = 0;  ///< dR_d / d log sigma_s'
 };
@@ -24,7 +24,8 @@ class DipoleGradientModel {
     alpha_ = sigma_s_reduced / st;
     sigma_tr_ = std::sqrt(3 * sigma_a * st);
     z_r_ = 1 / st;
-    const double A = materials::derive_coefficients(materials::Medium<double>{0, 1, 0, eta}).A_dipole;
+    const double A =
+        materials::derive_coefficients(materials::Medium<double>{0, 1, 0, eta}).A_dipole;
     virtual_factor_ = 1 + 4 * A / 3;  // z_v = z_r (1 + 4A/3), since D = z_r / 3
     z_v_ = z_r_ * virtual_factor_;
     const double st2 = st * st;
@@ -45,8 +46,8 @@ class DipoleGradientModel {
     DipoleGradient g;
     g.value = k * alpha_ * sum;
     for (int p = 0; p < 2; ++p) {
-      const double d_sum = fz_r * d_z_r_[p] + fz_v * d_z_r_[p] * virtual_factor_ +
-                           (fs_r + fs_v) * d_sigma_tr_[p];
+      const double d_sum =
+          fz_r * d_z_r_[p] + fz_v * d_z_r_[p] * virtual_factor_ + (fs_r + fs_v) * d_sigma_tr_[p];
       (p == 0 ? g.d_log_sigma_a : g.d_log_sigma_s) = k * (d_alpha_[p] * sum + alpha_ * d_sum);
     }
     return g;

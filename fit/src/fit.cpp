@@ -1,21 +1,21 @@
 #include "lucent/fit/fit.h"
 
 #include <ceres/ceres.h>
-#include <glog/logging.h>
 #include <ceres/covariance.h>
+#include <glog/logging.h>
 
 #include <Eigen/Dense>
 #include <algorithm>
 #include <chrono>
-#include <deque>
 #include <cmath>
+#include <deque>
 #include <numbers>
 #include <sstream>
 
+#include "dipole_gradient.h"
 #include "lucent/materials/albedo.h"
 #include "lucent/materials/error.h"
 #include "lucent/version.h"
-#include "dipole_gradient.h"
 #include "model_prediction.h"
 
 namespace lucent::fit {
@@ -37,7 +37,8 @@ CaptureGeometry geometry_of(const ProfileData& d) {
   return g;
 }
 
-// What one residual block measures: a run of radial bins or 2D samples of one channel of one capture.
+// What one residual block measures: a run of radial bins or 2D samples of one channel of one
+// capture.
 struct Observations {
   bool radial = true;
   CaptureGeometry geometry;
@@ -56,7 +57,8 @@ struct ProfileResiduals {
   GaussLegendre gl;
 
   template <typename T>
-  bool operator()(const T* const ab, const T* const log_scale, const T* const eta, T* residual) const {
+  bool operator()(const T* const ab, const T* const log_scale, const T* const eta,
+                  T* residual) const {
     return evaluate(ab, log_scale[0], eta[0], residual);
   }
 
@@ -64,23 +66,25 @@ struct ProfileResiduals {
   bool evaluate(const T* const ab, const T& log_scale, const T& eta, T* residual) const {
     using std::exp;
     using std::log;
-    const materials::Medium<T> medium = materials::Medium<T>::from_reduced(exp(ab[0]), exp(ab[1]), eta);
-    const T log_front =
-        log_scale + log(detail::fresnel_factor(obs->geometry, eta, model == FitModel::kDirectionalDipole));
+    const materials::Medium<T> medium =
+        materials::Medium<T>::from_reduced(exp(ab[0]), exp(ab[1]), eta);
+    const T log_front = log_scale + log(detail::fresnel_factor(
+                                        obs->geometry, eta, model == FitModel::kDirectionalDipole));
     const std::size_t n = obs->log_value.size();
     if (model == FitModel::kDipole) {
       const materials::StandardDipole<T> dipole(medium);
       for (std::size_t i = 0; i < n; ++i) {
-        const T v = obs->radial ? detail::dipole_annulus(dipole, obs->r[i], obs->r0[i], obs->r1[i], gl)
-                                : detail::dipole_pixel(dipole, obs->x[i], obs->y[i], obs->pixel, gl);
+        const T v = obs->radial
+                        ? detail::dipole_annulus(dipole, obs->r[i], obs->r0[i], obs->r1[i], gl)
+                        : detail::dipole_pixel(dipole, obs->x[i], obs->y[i], obs->pixel, gl);
         residual[i] = (log_front + log(v + T(1e-300)) - obs->log_value[i]) * obs->inv_rel_se[i];
       }
     } else {
       const materials::DirectionalDipole<T> dd(medium);
       for (std::size_t i = 0; i < n; ++i) {
-        const T v = obs->radial
-                        ? detail::ddipole_annulus(dd, obs->r[i], obs->r0[i], obs->r1[i], gl)
-                        : detail::ddipole_pixel(dd, obs->geometry, obs->x[i], obs->y[i], obs->pixel, gl);
+        const T v = obs->radial ? detail::ddipole_annulus(dd, obs->r[i], obs->r0[i], obs->r1[i], gl)
+                                : detail::ddipole_pixel(dd, obs->geometry, obs->x[i], obs->y[i],
+                                                        obs->pixel, gl);
         residual[i] = (log_front + log(v + T(1e-300)) - obs->log_value[i]) * obs->inv_rel_se[i];
       }
     }
@@ -101,7 +105,8 @@ struct ChannelResiduals {
   }
 };
 
-// The standard dipole with a hand-written Jacobian (scale and eta held): annuli, or pixel footprints.
+// The standard dipole with a hand-written Jacobian (scale and eta held): annuli, or pixel
+// footprints.
 class DipoleRadialCost : public ceres::CostFunction {
  public:
   // Parameter blocks: {log sigma_a, log sigma_s'} and {log scale}.
@@ -112,10 +117,12 @@ class DipoleRadialCost : public ceres::CostFunction {
     mutable_parameter_block_sizes()->push_back(1);
   }
 
-  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
     const double* ab = parameters[0];
     const detail::DipoleGradientModel model(std::exp(ab[0]), std::exp(ab[1]), *eta_);
-    const double log_front = parameters[1][0] + std::log(detail::fresnel_factor(obs_->geometry, *eta_, false));
+    const double log_front =
+        parameters[1][0] + std::log(detail::fresnel_factor(obs_->geometry, *eta_, false));
     for (std::size_t i = 0; i < obs_->log_value.size(); ++i) {
       detail::DipoleGradient sum;
       const auto add = [&](double weight, double r) {
@@ -140,7 +147,8 @@ class DipoleRadialCost : public ceres::CostFunction {
         add(1.0, obs_->r[i]);
       } else {
         const double r0 = obs_->r0[i], r1 = obs_->r1[i];
-        for (int k = 0; k < gl_.order; ++k) add(gl_.weight[k], std::sqrt(r0 * r0 + gl_.node[k] * (r1 * r1 - r0 * r0)));
+        for (int k = 0; k < gl_.order; ++k)
+          add(gl_.weight[k], std::sqrt(r0 * r0 + gl_.node[k] * (r1 * r1 - r0 * r0)));
       }
       const double v = sum.value + 1e-300;
       const double w = obs_->inv_rel_se[i];
@@ -190,7 +198,11 @@ double far_field_sigma_tr(const RadialBins& bins, int c) {
       const double r = bins.r_mm[i];
       const double y = std::log(bins.value[c][i] * r * r * r / (1 + s * r));
       const double w = std::pow(bins.value[c][i] / bins.standard_error[c][i], 2);
-      sw += w; sx += w * r; sy += w * y; sxx += w * r * r; sxy += w * r * y;
+      sw += w;
+      sx += w * r;
+      sy += w * y;
+      sxx += w * r * r;
+      sxy += w * r * y;
     }
     const double denominator = sw * sxx - sx * sx;
     if (!(denominator > 0)) break;
@@ -214,7 +226,8 @@ double plane_total(const RadialBins& bins, int c, double sigma_tr) {
   if (bins.size() > 0) {
     const std::size_t last = bins.size() - 1;
     const double R = bins.r_outer_mm[last], r = bins.r_mm[last];
-    const double C = bins.value[c][last] * r * r * r / ((1 + sigma_tr * r) * std::exp(-sigma_tr * r));
+    const double C =
+        bins.value[c][last] * r * r * r / ((1 + sigma_tr * r) * std::exp(-sigma_tr * r));
     if (std::isfinite(C) && C > 0) total += 2 * std::numbers::pi * C * std::exp(-sigma_tr * R) / R;
   }
   return total;
@@ -223,8 +236,8 @@ double plane_total(const RadialBins& bins, int c, double sigma_tr) {
 }  // namespace
 
 GaussLegendre detail::gauss_legendre(int order) {
-  // Golub-Welsch: nodes are the eigenvalues of the Jacobi matrix of the Legendre recurrence, weights
-  // twice the squared first components of its eigenvectors; mapped from [-1, 1] to [0, 1].
+  // Golub-Welsch: nodes are the eigenvalues of the Jacobi matrix of the Legendre recurrence,
+  // weights twice the squared first components of its eigenvectors; mapped from [-1, 1] to [0, 1].
   order = std::clamp(order, 1, 8);
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(order, order);
   for (int k = 1; k < order; ++k) {
@@ -265,7 +278,6 @@ QualitySettings quality_settings(Quality quality) {
   return s;
 }
 
-
 namespace {
 
 const char* kChannelNames[3] = {"R", "G", "B"};
@@ -293,11 +305,13 @@ Observations observations_for(const ProfileData& d, int c, double exclude_mm, bo
     o.pixel = s.pixel_mm;
     std::vector<std::size_t> idx;
     for (std::size_t i = 0; i < s.size(); ++i) {
-      if (std::hypot(s.x_mm[i], s.y_mm[i]) >= exclude_mm && keep(s.value[c][i], s.standard_error[c][i])) {
+      if (std::hypot(s.x_mm[i], s.y_mm[i]) >= exclude_mm &&
+          keep(s.value[c][i], s.standard_error[c][i])) {
         idx.push_back(i);
       }
     }
-    const std::size_t stride = std::max<std::size_t>(1, (idx.size() + q.max_samples_2d - 1) / q.max_samples_2d);
+    const std::size_t stride =
+        std::max<std::size_t>(1, (idx.size() + q.max_samples_2d - 1) / q.max_samples_2d);
     for (std::size_t k = 0; k < idx.size(); k += stride) {
       const std::size_t i = idx[k];
       o.x.push_back(s.x_mm[i]);
@@ -335,7 +349,8 @@ StartValues start_values(const ProfileData& d, int c, double eta, bool relative)
   const double fresnel = detail::fresnel_factor(g, eta, false);
   if (!relative) {
     const double total = plane_total(d.radial, c, sigma_tr) / fresnel;
-    if (total > 0 && total < 1) alpha = materials::reduced_albedo_from_total_reflectance(total, eta);
+    if (total > 0 && total < 1)
+      alpha = materials::reduced_albedo_from_total_reflectance(total, eta);
     alpha = std::clamp(alpha, 0.05, 1 - 1e-6);
   } else {
     // Unknown scale: the albedo whose dipole shape (for this sigma_tr) best matches the data, the
@@ -344,7 +359,8 @@ StartValues start_values(const ProfileData& d, int c, double eta, bool relative)
     for (double one_minus = 0.5; one_minus > 1e-6; one_minus *= 0.7) {
       const double a = 1 - one_minus;
       const double st = sigma_tr / std::sqrt(3 * (1 - a));
-      const materials::StandardDipole<double> dipole(materials::Medium<double>::from_reduced((1 - a) * st, a * st, eta));
+      const materials::StandardDipole<double> dipole(
+          materials::Medium<double>::from_reduced((1 - a) * st, a * st, eta));
       double sum = 0, sum2 = 0;
       int n = 0;
       for (std::size_t i = 0; i < d.radial.size(); ++i) {
@@ -375,14 +391,17 @@ StartValues start_values(const ProfileData& d, int c, double eta, bool relative)
   // thousand dipole evaluations, cheap next to the solve, and the solve starts in the right valley.
   std::vector<std::size_t> use;
   for (std::size_t i = 0; i < d.radial.size(); ++i) {
-    if (d.radial.r_mm[i] > 0 && d.radial.value[c][i] > 2 * d.radial.standard_error[c][i]) use.push_back(i);
+    if (d.radial.r_mm[i] > 0 && d.radial.value[c][i] > 2 * d.radial.standard_error[c][i])
+      use.push_back(i);
   }
   if (use.size() >= 4) {
     std::vector<std::size_t> pick;
-    for (int k = 0; k < 12; ++k) pick.push_back(use[std::min(use.size() - 1, k * (use.size() - 1) / 11)]);
+    for (int k = 0; k < 12; ++k)
+      pick.push_back(use[std::min(use.size() - 1, k * (use.size() - 1) / 11)]);
     const double r_min = d.radial.r_mm[pick.front()], r_max = d.radial.r_mm[pick.back()];
     const auto cost = [&](double sa, double ss, double* log_scale) {
-      const materials::StandardDipole<double> dipole(materials::Medium<double>::from_reduced(sa, ss, eta));
+      const materials::StandardDipole<double> dipole(
+          materials::Medium<double>::from_reduced(sa, ss, eta));
       double sum = 0, sum2 = 0, wsum = 0;
       std::array<double, 12> diff{}, w{};
       for (std::size_t k = 0; k < pick.size(); ++k) {
@@ -401,7 +420,8 @@ StartValues start_values(const ProfileData& d, int c, double eta, bool relative)
     };
     double best_shift = sv.log_scale;
     double best = cost(sv.sigma_a, sv.sigma_s_reduced, &best_shift);
-    const double alphas[] = {0.05, 0.2, 0.4, 0.6, 0.8, 0.9, 0.95, 0.98, 0.99, 0.995, 0.998, 0.999, 0.9995, 0.9999};
+    const double alphas[] = {0.05, 0.2,  0.4,   0.6,   0.8,   0.9,    0.95,
+                             0.98, 0.99, 0.995, 0.998, 0.999, 0.9995, 0.9999};
     for (double a : alphas) {
       for (int k = 0; k < 16; ++k) {
         const double st = 0.2 / r_max * std::pow(100.0 * r_max / r_min, k / 15.0);
@@ -425,7 +445,7 @@ struct Problem {
   double log_scale = 0;
   double eta = 1.3;
   std::deque<std::array<double, 3>> calibration;  // per profile and channel: log scale with a prior
-  std::deque<Observations> observations;  // owned: residual blocks point into it (stable)
+  std::deque<Observations> observations;          // owned: residual blocks point into it (stable)
 };
 
 // Describes a null-space vector over the free parameters.
@@ -444,7 +464,8 @@ std::string describe_combination(const Eigen::VectorXd& v, const std::vector<std
 
 ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, FitModel model,
                double eta0, bool relative, double exclude_mm,
-               const std::array<StartValues, 3>& start, std::array<bool, 3> channels, int* below_noise) {
+               const std::array<StartValues, 3>& start, std::array<bool, 3> channels,
+               int* below_noise) {
   const QualitySettings q = quality_settings(options.quality);
   const GaussLegendre gl = detail::gauss_legendre(q.footprint_order);
   Problem p;
@@ -474,16 +495,19 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
       const double cal_se = d.calibrated && !relative ? d.calibration_relative_se[c] : 0.0;
       if (cal_se > 0) {
         scale = &p.calibration.back()[c];
-        problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ScalePrior, 1, 1>(new ScalePrior{1.0 / cal_se}),
-                                 nullptr, scale);
+        problem.AddResidualBlock(
+            new ceres::AutoDiffCostFunction<ScalePrior, 1, 1>(new ScalePrior{1.0 / cal_se}),
+            nullptr, scale);
         block_channels.emplace_back(-1, 1);  // the prior's residual: not a sample
-        calibration_blocks.emplace_back(scale, std::string("log calibration[") + kChannelNames[c] +
-                                                   (data.size() > 1 ? ", input " + std::to_string(di + 1) : "") + "]");
+        calibration_blocks.emplace_back(
+            scale, std::string("log calibration[") + kChannelNames[c] +
+                       (data.size() > 1 ? ", input " + std::to_string(di + 1) : "") + "]");
       }
       const bool scale_free = scale != &p.log_scale || relative;
       if (options.loss == LossKind::kNone && !options.fit_ior && options.analytic_derivatives &&
           model == FitModel::kDipole) {
-        problem.AddResidualBlock(new DipoleRadialCost(&o, gl, &p.eta), nullptr, p.ab[c].data(), scale);
+        problem.AddResidualBlock(new DipoleRadialCost(&o, gl, &p.eta), nullptr, p.ab[c].data(),
+                                 scale);
         block_channels.emplace_back(c, int(o.log_value.size()));
       } else if (options.loss == LossKind::kNone && !options.fit_ior && !scale_free) {
         auto* cost = new ceres::AutoDiffCostFunction<ChannelResiduals, ceres::DYNAMIC, 2>(
@@ -500,14 +524,22 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
         for (std::size_t i = 0; i < o.log_value.size(); ++i) {
           p.observations.push_back(o);
           Observations& one = p.observations.back();
-          const auto pick = [&](std::vector<double>& v) { if (!v.empty()) v = {v[i]}; };
-          pick(one.r); pick(one.r0); pick(one.r1); pick(one.x); pick(one.y);
-          pick(one.log_value); pick(one.inv_rel_se);
+          const auto pick = [&](std::vector<double>& v) {
+            if (!v.empty()) v = {v[i]};
+          };
+          pick(one.r);
+          pick(one.r0);
+          pick(one.r1);
+          pick(one.x);
+          pick(one.y);
+          pick(one.log_value);
+          pick(one.inv_rel_se);
           auto* cost = new ceres::AutoDiffCostFunction<ProfileResiduals, ceres::DYNAMIC, 2, 1, 1>(
               new ProfileResiduals{&one, model, gl}, 1);
-          ceres::LossFunction* loss = options.loss == LossKind::kHuber
-                                          ? static_cast<ceres::LossFunction*>(new ceres::HuberLoss(options.loss_scale))
-                                          : new ceres::CauchyLoss(options.loss_scale);
+          ceres::LossFunction* loss =
+              options.loss == LossKind::kHuber
+                  ? static_cast<ceres::LossFunction*>(new ceres::HuberLoss(options.loss_scale))
+                  : new ceres::CauchyLoss(options.loss_scale);
           problem.AddResidualBlock(cost, loss, p.ab[c].data(), scale, &p.eta);
           block_channels.emplace_back(c, 1);
         }
@@ -516,15 +548,20 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
   }
   for (int c = 0; c < 3; ++c) {
     if (channels[c] && samples[c] < 2) {
-      throw Error(std::string("fit: channel ") + kChannelNames[c] + " has " + std::to_string(samples[c]) +
-                  " usable samples outside the exclusion radius (" + std::to_string(exclude_mm) +
+      throw Error(std::string("fit: channel ") + kChannelNames[c] + " has " +
+                  std::to_string(samples[c]) + " usable samples outside the exclusion radius (" +
+                  std::to_string(exclude_mm) +
                   " mm) and above the noise floor; at least 2 are needed for sigma_a and sigma_s'");
     }
   }
-  if (problem.HasParameterBlock(&p.log_scale) && !relative) problem.SetParameterBlockConstant(&p.log_scale);
+  if (problem.HasParameterBlock(&p.log_scale) && !relative)
+    problem.SetParameterBlockConstant(&p.log_scale);
   if (problem.HasParameterBlock(&p.eta)) {
-    if (!options.fit_ior) problem.SetParameterBlockConstant(&p.eta);
-    else problem.SetParameterLowerBound(&p.eta, 0, 1.0001), problem.SetParameterUpperBound(&p.eta, 0, 2.5);
+    if (!options.fit_ior)
+      problem.SetParameterBlockConstant(&p.eta);
+    else
+      problem.SetParameterLowerBound(&p.eta, 0, 1.0001),
+          problem.SetParameterUpperBound(&p.eta, 0, 2.5);
   }
 
   ceres::Solver::Options so;
@@ -553,7 +590,8 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
   }
   if (relative) blocks.push_back(&p.log_scale), names.push_back("log scale");
   if (options.fit_ior) blocks.push_back(&p.eta), names.push_back("eta");
-  for (const auto& [block, name] : calibration_blocks) blocks.push_back(block), names.push_back(name);
+  for (const auto& [block, name] : calibration_blocks)
+    blocks.push_back(block), names.push_back(name);
 
   ceres::Problem::EvaluateOptions eo;
   eo.parameter_blocks = blocks;
@@ -581,7 +619,8 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
   // (J^T J)^+ from the SVD: the covariance of the free parameters when the standard errors are
   // honest; directions the data does not determine are left out and reported instead.
   covariance = svd.matrixV() * inv2.asDiagonal() * svd.matrixV().transpose();
-  fit.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  fit.time_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
   fit.converged = summary.termination_type == ceres::CONVERGENCE;
   fit.iterations = int(summary.iterations.size()) - 1;
@@ -618,8 +657,8 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
         if (c >= 0) chi2[c] += residuals[offset] * residuals[offset];
       }
     }
-    // fit.chi2 (AIC, BIC) keeps the calibration priors' share: a model that reaches the data only by
-    // rescaling the calibration far beyond its uncertainty pays for it.
+    // fit.chi2 (AIC, BIC) keeps the calibration priors' share: a model that reaches the data only
+    // by rescaling the calibration far beyond its uncertainty pays for it.
     for (int c = 0; c < 3; ++c) {
       fit.channels[c].chi2 = chi2[c];
       fit.channels[c].residual_rms = samples[c] ? std::sqrt(chi2[c] / samples[c]) : 0.0;
@@ -660,15 +699,17 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
   std::optional<double> eta = options.ior;
   if (!eta) eta = data.front().eta;
   if (!eta && !options.fit_ior) {
-    throw Error("--ior: the relative index of refraction is required (the data does not carry one); "
-                "or use --fit-ior");
+    throw Error(
+        "--ior: the relative index of refraction is required (the data does not carry one); "
+        "or use --fit-ior");
   }
   const double eta0 = eta.value_or(1.4);
   bool any_relative = false;
   for (const ProfileData& d : data) any_relative |= !d.calibrated;
   const bool relative = options.relative.value_or(any_relative);
   if (!relative && any_relative) {
-    throw Error("--relative: an input profile is uncalibrated (relative values); its scale must be fitted");
+    throw Error(
+        "--relative: an input profile is uncalibrated (relative values); its scale must be fitted");
   }
   std::array<bool, 3> channels{false, false, false};
   for (const ProfileData& d : data) {
@@ -699,8 +740,10 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
   }
 
   std::vector<FitModel> models;
-  if (options.model == FitModel::kAuto) models = {FitModel::kDipole, FitModel::kDirectionalDipole};
-  else models = {options.model};
+  if (options.model == FitModel::kAuto)
+    models = {FitModel::kDipole, FitModel::kDirectionalDipole};
+  else
+    models = {options.model};
   int below_noise = 0;
   for (FitModel m : models) {
     below_noise = 0;
@@ -725,7 +768,8 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
     result.reason = "model " + model_name(result.chosen.model) + " requested";
   } else {
     // The simplest model the data does not reject: the standard dipole unless the directional one
-    // fits markedly better (AIC lower by more than 10, i.e. the dipole is e^5 = 150 times less likely).
+    // fits markedly better (AIC lower by more than 10, i.e. the dipole is e^5 = 150 times less
+    // likely).
     const ModelFit& dipole = result.candidates[0];
     const ModelFit& ddipole = result.candidates[1];
     std::ostringstream why;
@@ -747,8 +791,10 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
     if (se > 0 && std::abs(std::log(s)) > 3 * se) {
       std::ostringstream note;
       note.precision(3);
-      note << "channel " << kChannelNames[c] << ": the model reaches the data only with the calibration scaled by "
-           << s << " (its uncertainty is " << 100 * se << "%): model and data disagree in absolute level";
+      note << "channel " << kChannelNames[c]
+           << ": the model reaches the data only with the calibration scaled by " << s
+           << " (its uncertainty is " << 100 * se
+           << "%): model and data disagree in absolute level";
       result.notes.push_back(note.str());
     }
   }

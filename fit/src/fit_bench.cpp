@@ -1,12 +1,12 @@
 #include "lucent/fit/fit_bench.h"
 
+#include <unistd.h>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
 #include <ostream>
 #include <sstream>
-#include <unistd.h>
 
 #include "lucent/acquire/acquire.h"
 #include "lucent/acquire/plot.h"
@@ -27,8 +27,9 @@ struct BenchCase {
 };
 
 // Simulated with a diffusion model as the source: the truth is exact for that model.
-BenchCase model_case(const std::string& name, const std::string& material, acquire::RadianceSource source,
-                     double incidence_deg, int size, const fs::path& scratch) {
+BenchCase model_case(const std::string& name, const std::string& material,
+                     acquire::RadianceSource source, double incidence_deg, int size,
+                     const fs::path& scratch) {
   acquire::SimulateOptions o;
   o.material = materials::load_material(material);
   o.source = source;
@@ -51,22 +52,28 @@ double median(std::vector<double> v) {
 
 int run_fit_bench(const FitBenchOptions& options, std::ostream& log) {
   if (options.repeats < 1) throw Error("--repeats: expected at least 1");
-  const fs::path scratch = fs::temp_directory_path() / ("lucent-bench-fit-" + std::to_string(::getpid()));
+  const fs::path scratch =
+      fs::temp_directory_path() / ("lucent-bench-fit-" + std::to_string(::getpid()));
   fs::remove_all(scratch);
   fs::create_directories(scratch);
   struct Cleanup {
     fs::path dir;
-    ~Cleanup() { std::error_code ec; fs::remove_all(dir, ec); }
+    ~Cleanup() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
   } cleanup{scratch};
 
   std::vector<BenchCase> cases;
   log << "bench fit: preparing captures\n";
   cases.push_back(model_case("potato-dipole-0deg", "potato", acquire::RadianceSource::kDipole, 0,
                              options.size_px, scratch));
-  cases.push_back(model_case("skin1-ddipole-0deg", "skin1", acquire::RadianceSource::kDirectionalDipole, 0,
-                             options.size_px, scratch));
-  cases.push_back(model_case("marble-ddipole-45deg", "marble", acquire::RadianceSource::kDirectionalDipole,
-                             45, options.size_px, scratch));
+  cases.push_back(model_case("skin1-ddipole-0deg", "skin1",
+                             acquire::RadianceSource::kDirectionalDipole, 0, options.size_px,
+                             scratch));
+  cases.push_back(model_case("marble-ddipole-45deg", "marble",
+                             acquire::RadianceSource::kDirectionalDipole, 45, options.size_px,
+                             scratch));
   if (fs::exists(options.sample_capture)) {
     const fs::path acq = scratch / "sample-acq";
     acquire::run_acquire(options.sample_capture, acq);
@@ -75,13 +82,17 @@ int run_fit_bench(const FitBenchOptions& options, std::ostream& log) {
     cases.push_back({"marble-montecarlo-0deg", load_profile_data(acq / "profile.json"),
                      materials::material_from_json(truth["material"], "truth.json")});
   } else {
-    log << "bench fit: " << options.sample_capture << " not found; the Monte Carlo case is skipped\n";
+    log << "bench fit: " << options.sample_capture
+        << " not found; the Monte Carlo case is skipped\n";
   }
 
   std::ostringstream csv;
   csv << "case,model,quality,derivatives,time_ms_median,samples,sigma_a_rel_error,"
          "sigma_s_reduced_rel_error,residual_rms\n";
-  struct Point { double time_ms, error; int series; };
+  struct Point {
+    double time_ms, error;
+    int series;
+  };
   std::vector<Point> points;
   std::vector<std::string> series_names;
   int settings = 0;
@@ -90,8 +101,9 @@ int run_fit_bench(const FitBenchOptions& options, std::ostream& log) {
     for (FitModel model : {FitModel::kDipole, FitModel::kDirectionalDipole}) {
       for (bool analytic : {true, false}) {
         if (analytic && model != FitModel::kDipole) continue;  // analytic Jacobian: dipole only
-        const std::string series = bc.name + " / " + (model == FitModel::kDipole ? "dipole" : "ddipole") +
-                                   (model == FitModel::kDipole ? (analytic ? " analytic" : " autodiff") : "");
+        const std::string series =
+            bc.name + " / " + (model == FitModel::kDipole ? "dipole" : "ddipole") +
+            (model == FitModel::kDipole ? (analytic ? " analytic" : " autodiff") : "");
         series_names.push_back(series);
         for (int q = 0; q < 3; ++q) {
           FitOptions fo;
@@ -104,7 +116,9 @@ int run_fit_bench(const FitBenchOptions& options, std::ostream& log) {
           for (int k = 0; k < options.repeats; ++k) {
             const auto t0 = std::chrono::steady_clock::now();
             result = fit_profiles({bc.data}, fo);
-            times.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+            times.push_back(
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                    .count());
           }
           double err_a = 0, err_s = 0, rms = 0;
           int n = 0;
@@ -119,9 +133,11 @@ int run_fit_bench(const FitBenchOptions& options, std::ostream& log) {
           err_a /= n, err_s /= n, rms /= n;
           const double t = median(times);
           csv << bc.name << ',' << (model == FitModel::kDipole ? "dipole" : "ddipole") << ','
-              << quality_names[q] << ',' << (model == FitModel::kDipole && analytic ? "analytic" : "automatic")
-              << ',' << t << ',' << result.chosen.samples << ',' << err_a << ',' << err_s << ',' << rms << '\n';
-          points.push_back({t, std::max(1e-7, 0.5 * (err_a + err_s)), int(series_names.size()) - 1});
+              << quality_names[q] << ','
+              << (model == FitModel::kDipole && analytic ? "analytic" : "automatic") << ',' << t
+              << ',' << result.chosen.samples << ',' << err_a << ',' << err_s << ',' << rms << '\n';
+          points.push_back(
+              {t, std::max(1e-7, 0.5 * (err_a + err_s)), int(series_names.size()) - 1});
           log << "  " << series << ", " << quality_names[q] << ": " << t << " ms, sigma_a error "
               << 100 * err_a << "%, sigma_s' error " << 100 * err_s << "%\n";
           ++settings;
@@ -133,13 +149,23 @@ int run_fit_bench(const FitBenchOptions& options, std::ostream& log) {
   fs::create_directories(options.out_dir);
   write_file_atomically(options.out_dir / "fit_tradeoff.csv", csv.str());
   acquire::PlotPanel panel;
-  panel.title = "fit speed against accuracy: mean relative parameter error vs median solve time "
-                "(fast, balanced, accurate joined)";
+  panel.title =
+      "fit speed against accuracy: mean relative parameter error vs median solve time "
+      "(fast, balanced, accurate joined)";
   panel.x_label = "time per fit (ms, log)";
   panel.log_x = panel.log_y = true;
-  const std::array<std::array<std::uint8_t, 3>, 12> palette{
-      {{200, 30, 30}, {30, 140, 30}, {30, 60, 210}, {200, 120, 0}, {140, 0, 160}, {0, 150, 150},
-       {90, 90, 90}, {220, 0, 120}, {120, 80, 20}, {0, 90, 60}, {100, 100, 230}, {230, 160, 160}}};
+  const std::array<std::array<std::uint8_t, 3>, 12> palette{{{200, 30, 30},
+                                                             {30, 140, 30},
+                                                             {30, 60, 210},
+                                                             {200, 120, 0},
+                                                             {140, 0, 160},
+                                                             {0, 150, 150},
+                                                             {90, 90, 90},
+                                                             {220, 0, 120},
+                                                             {120, 80, 20},
+                                                             {0, 90, 60},
+                                                             {100, 100, 230},
+                                                             {230, 160, 160}}};
   for (std::size_t s = 0; s < series_names.size(); ++s) {
     acquire::PlotSeries series;
     series.rgb = palette[s % palette.size()];
@@ -150,10 +176,11 @@ int run_fit_bench(const FitBenchOptions& options, std::ostream& log) {
     }
     panel.series.push_back(series);
   }
-  acquire::write_plot_png(options.out_dir / "fit_tradeoff.png", {panel},
-                          {"error: mean over channels of |fitted / truth - 1| for sigma_a and sigma_s', averaged",
-                           "model-made captures have an exact truth for their model; the Monte Carlo one has none"},
-                          1100, 700);
+  acquire::write_plot_png(
+      options.out_dir / "fit_tradeoff.png", {panel},
+      {"error: mean over channels of |fitted / truth - 1| for sigma_a and sigma_s', averaged",
+       "model-made captures have an exact truth for their model; the Monte Carlo one has none"},
+      1100, 700);
   return settings;
 }
 

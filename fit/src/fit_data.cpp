@@ -83,7 +83,8 @@ ProfileData load_csv(const std::filesystem::path& path) {
       const std::string& t = f[col];
       const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
       if (ec != std::errc() || end != t.data() + t.size() || !std::isfinite(v)) {
-        throw Error(where + "column " + header[col] + ": expected a finite number, got '" + t + "'");
+        throw Error(where + "column " + header[col] + ": expected a finite number, got '" + t +
+                    "'");
       }
       return v;
     };
@@ -97,7 +98,8 @@ ProfileData load_csv(const std::filesystem::path& path) {
       double se = 0;
       if (se_col[c] >= 0) {
         se = number(se_col[c]);
-        if (!(se > 0)) throw Error(where + "column " + header[se_col[c]] + ": expected a standard error > 0");
+        if (!(se > 0))
+          throw Error(where + "column " + header[se_col[c]] + ": expected a standard error > 0");
       } else {
         se = 0.05 * std::abs(v);  // documented assumption: 5% relative error
         assumed_errors = true;
@@ -119,7 +121,8 @@ ProfileData load_json(const std::filesystem::path& path) {
   if (p.beam_power && p.provenance.contains("white_reference")) {
     const auto& white = p.provenance["white_reference"];
     if (white.is_object() && white.contains("beam_power_standard_error") &&
-        white["beam_power_standard_error"].is_array() && white["beam_power_standard_error"].size() == 3) {
+        white["beam_power_standard_error"].is_array() &&
+        white["beam_power_standard_error"].size() == 3) {
       for (int c = 0; c < 3; ++c) {
         const auto& se = white["beam_power_standard_error"][c];
         if (se.is_number() && (*p.beam_power)[c] > 0) {

@@ -17,7 +17,9 @@ std::string name_of(Quality q) {
   return q == Quality::kFast ? "fast" : q == Quality::kBalanced ? "balanced" : "accurate";
 }
 
-json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+json finite_or_null(double v) {
+  return std::isfinite(v) ? json(v) : json(nullptr);
+}
 
 json model_fit_json(const ModelFit& f) {
   json channels = json::array();

@@ -23,22 +23,26 @@ double predicted_radial(const ModelFit& fit, const ProfileData& data, int c, dou
       fit.model == FitModel::kDipole
           ? detail::dipole_pixel(materials::StandardDipole<double>(medium), r, 0.0, p, gl)
           : detail::ddipole_pixel(materials::DirectionalDipole<double>(medium), g, r, 0.0, p, gl);
-  return fit.scale * fit.calibration_scale[c] * detail::fresnel_factor(g, fit.eta, fit.model == FitModel::kDirectionalDipole) * v;
+  return fit.scale * fit.calibration_scale[c] *
+         detail::fresnel_factor(g, fit.eta, fit.model == FitModel::kDirectionalDipole) * v;
 }
 
 void write_fit_plot(const std::filesystem::path& path, const FitResult& result,
                     const ProfileData& data) {
   using acquire::PlotPanel;
   using acquire::PlotSeries;
-  const std::array<std::array<std::uint8_t, 3>, 3> colours{{{200, 30, 30}, {30, 150, 30}, {30, 60, 210}}};
-  const std::array<std::array<std::uint8_t, 3>, 3> light{{{240, 160, 160}, {150, 210, 150}, {160, 175, 240}}};
+  const std::array<std::array<std::uint8_t, 3>, 3> colours{
+      {{200, 30, 30}, {30, 150, 30}, {30, 60, 210}}};
+  const std::array<std::array<std::uint8_t, 3>, 3> light{
+      {{240, 160, 160}, {150, 210, 150}, {160, 175, 240}}};
   const char* names[3] = {"R", "G", "B"};
   const ModelFit& f = result.chosen;
   PlotPanel profile;
-  profile.title = "profile: data (points, +-1 SE) and " +
-                  std::string(f.model == FitModel::kDipole ? "standard dipole" : "directional dipole") +
-                  " fit (lines); excluded region in light colours; y: " +
-                  (data.calibrated ? "pi L / P (1/mm^2)" : "pi L (relative)");
+  profile.title =
+      "profile: data (points, +-1 SE) and " +
+      std::string(f.model == FitModel::kDipole ? "standard dipole" : "directional dipole") +
+      " fit (lines); excluded region in light colours; y: " +
+      (data.calibrated ? "pi L / P (1/mm^2)" : "pi L (relative)");
   profile.x_label = "r (mm)";
   profile.log_y = true;
   profile.height_weight = 2.2;
@@ -88,16 +92,18 @@ void write_fit_plot(const std::filesystem::path& path, const FitResult& result,
     if (!data.channels[c]) continue;
     const ChannelFit& ch = f.channels[c];
     std::snprintf(line, sizeof line,
-                  "%s: sigma_a = %.4g +- %.2g /mm   sigma_s' = %.4g +- %.2g /mm   corr %.2f   rms %.2f SE (%d samples)",
+                  "%s: sigma_a = %.4g +- %.2g /mm   sigma_s' = %.4g +- %.2g /mm   corr %.2f   rms "
+                  "%.2f SE (%d samples)",
                   names[c], ch.sigma_a, ch.sd_sigma_a, ch.sigma_s_reduced, ch.sd_sigma_s_reduced,
                   ch.correlation, ch.residual_rms, ch.samples);
     footer.push_back(line);
   }
   std::snprintf(line, sizeof line,
-                "eta %.3f, scale %.4g, calibration %.4f %.4f %.4f, exclusion radius %.3g mm, %s in %d iterations, %.2f ms",
-                f.eta, f.scale, f.calibration_scale[0], f.calibration_scale[1], f.calibration_scale[2],
-                result.exclude_radius_mm, f.converged ? "converged" : "NOT converged",
-                f.iterations, f.time_ms);
+                "eta %.3f, scale %.4g, calibration %.4f %.4f %.4f, exclusion radius %.3g mm, %s in "
+                "%d iterations, %.2f ms",
+                f.eta, f.scale, f.calibration_scale[0], f.calibration_scale[1],
+                f.calibration_scale[2], result.exclude_radius_mm,
+                f.converged ? "converged" : "NOT converged", f.iterations, f.time_ms);
   footer.push_back(line);
   footer.push_back("model choice: " + result.reason);
   acquire::write_plot_png(path, {profile, residuals}, footer, 1100, 900);

@@ -1,6 +1,6 @@
 // The predicted measurement pi L / P of a capture, per channel, for a bin or pixel footprint: the
-// BSSRDF with both Fresnel transmittances (DESIGN §6), averaged over the footprint by Gauss-Legendre
-// quadrature. Templated for ceres::Jet.
+// BSSRDF with both Fresnel transmittances (DESIGN §6), averaged over the footprint by
+// Gauss-Legendre quadrature. Templated for ceres::Jet.
 #pragma once
 
 #include <array>
@@ -22,8 +22,8 @@ GaussLegendre gauss_legendre(int order);
 
 /// Geometry shared by every sample of one capture.
 struct CaptureGeometry {
-  double cos_incidence = 1;    ///< cos of the beam's polar angle
-  double cos_view = 1;         ///< cos of the camera's polar angle
+  double cos_incidence = 1;            ///< cos of the beam's polar angle
+  double cos_view = 1;                 ///< cos of the camera's polar angle
   std::array<double, 3> w_i{0, 0, 1};  ///< unit, from the entry point toward the light
   /// The data are exitance per unit power entering the sample (Monte Carlo tallies, CSV), not a
   /// camera's radiance per unit incident power.
@@ -31,14 +31,15 @@ struct CaptureGeometry {
 };
 
 /// What multiplies the model's R_d (dipole) or pi S_d (ddipole) to give the measured quantity: both
-/// Fresnel transmittances for a camera (pi L / P); for exitance per unit power entering, nothing for
-/// the dipole (R_d is an exitance) and the outgoing hemispherical transmittance for the ddipole,
-/// pi S_d integrated against F_t cos over the hemisphere: eta^2 (1 - F_dr(eta)) (transmittance from
-/// inside is 1 - F_dr, from outside eta^2 times that).
+/// Fresnel transmittances for a camera (pi L / P); for exitance per unit power entering, nothing
+/// for the dipole (R_d is an exitance) and the outgoing hemispherical transmittance for the
+/// ddipole, pi S_d integrated against F_t cos over the hemisphere: eta^2 (1 - F_dr(eta))
+/// (transmittance from inside is 1 - F_dr, from outside eta^2 times that).
 template <typename T>
 T fresnel_factor(const CaptureGeometry& g, const T& eta, bool directional) {
   using materials::fresnel_transmittance;
-  if (g.exitance) return directional ? eta * eta * (T(1) - materials::diffuse_fresnel_reflectance(eta)) : T(1);
+  if (g.exitance)
+    return directional ? eta * eta * (T(1) - materials::diffuse_fresnel_reflectance(eta)) : T(1);
   return fresnel_transmittance(T(g.cos_incidence), eta) * fresnel_transmittance(T(g.cos_view), eta);
 }
 
@@ -63,8 +64,8 @@ T ddipole_annulus(const materials::DirectionalDipole<T>& dd, double r, double r0
                   const GaussLegendre& gl) {
   const materials::Vec3<T> up(T(0), T(0), T(1));
   const auto at = [&](double rr) {
-    return T(std::numbers::pi) * dd.S_d(materials::Vec3<T>::Zero(), up, up,
-                                        materials::Vec3<T>(T(rr), T(0), T(0)), up);
+    return T(std::numbers::pi) *
+           dd.S_d(materials::Vec3<T>::Zero(), up, up, materials::Vec3<T>(T(rr), T(0), T(0)), up);
   };
   if (!(r1 > r0)) return at(r);
   T sum(0);
@@ -104,8 +105,9 @@ T dipole_pixel(const materials::StandardDipole<T>& dipole, double x, double y, d
   T sum(0);
   for (int a = 0; a < gl.order; ++a) {
     for (int b = 0; b < gl.order; ++b) {
-      sum += gl.weight[a] * gl.weight[b] *
-             dipole.R_d(T(std::hypot(x + (gl.node[a] - 0.5) * pixel, y + (gl.node[b] - 0.5) * pixel)));
+      sum +=
+          gl.weight[a] * gl.weight[b] *
+          dipole.R_d(T(std::hypot(x + (gl.node[a] - 0.5) * pixel, y + (gl.node[b] - 0.5) * pixel)));
     }
   }
   return sum;

@@ -108,7 +108,8 @@ AtomicOutputDir::AtomicOutputDir(std::filesystem::path target) : target_(std::mo
   std::filesystem::path parent = target_.parent_path();
   if (parent.empty()) parent = ".";
   if (!std::filesystem::is_directory(parent)) {
-    throw Error(target_.string() + ": cannot write: the folder " + parent.string() + " does not exist");
+    throw Error(target_.string() + ": cannot write: the folder " + parent.string() +
+                " does not exist");
   }
   if (std::filesystem::exists(target_) && !std::filesystem::is_directory(target_)) {
     throw Error(target_.string() + ": cannot write: exists and is not a folder");
@@ -136,7 +137,9 @@ void AtomicOutputDir::commit() {
   } else {
     for (const auto& entry : std::filesystem::directory_iterator(temporary_)) {
       std::filesystem::rename(entry.path(), target_ / entry.path().filename(), ec);
-      if (ec) throw Error((target_ / entry.path().filename()).string() + ": cannot write: " + ec.message());
+      if (ec)
+        throw Error((target_ / entry.path().filename()).string() +
+                    ": cannot write: " + ec.message());
     }
     std::filesystem::remove_all(temporary_, ec);
   }

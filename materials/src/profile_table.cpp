@@ -52,13 +52,15 @@ std::string format_input(double v) {
 // Model values: 17 significant digits.
 std::string format_number(double v) {
   char buffer[64];
-  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, v,
-                                          std::chars_format::general, 17);
+  const auto [end, error] =
+      std::to_chars(buffer, buffer + sizeof buffer, v, std::chars_format::general, 17);
   (void)error;  // 64 characters always suffice for 17 significant digits
   return std::string(buffer, end);
 }
 
-Vec3<double> plane_normal() { return {0.0, 0.0, 1.0}; }
+Vec3<double> plane_normal() {
+  return {0.0, 0.0, 1.0};
+}
 
 }  // namespace
 
@@ -88,7 +90,8 @@ std::vector<double> parse_radius_list(const std::string& text, const std::string
 
 std::vector<double> parse_radius_range(const std::string& text, const std::string& option) {
   const std::vector<std::string> parts = split(text, ':');
-  const std::string expected = option + ": expected FROM:TO:COUNT[:lin|log] in mm, got '" + text + "'";
+  const std::string expected =
+      option + ": expected FROM:TO:COUNT[:lin|log] in mm, got '" + text + "'";
   if (parts.size() != 3 && parts.size() != 4) throw Error(expected);
   double from = 0.0, to = 0.0, count_value = 0.0;
   if (!parse_double(parts[0], from) || !parse_double(parts[1], to) ||
@@ -98,7 +101,8 @@ std::vector<double> parse_radius_range(const std::string& text, const std::strin
   const std::string spacing = parts.size() == 4 ? parts[3] : "lin";
   if (spacing != "lin" && spacing != "log") throw Error(expected);
   if (from < 0.0 || to < from) {
-    throw Error(option + ": expected 0 <= FROM <= TO (mm), got FROM=" + parts[0] + " TO=" + parts[1]);
+    throw Error(option + ": expected 0 <= FROM <= TO (mm), got FROM=" + parts[0] +
+                " TO=" + parts[1]);
   }
   if (count_value < 1.0 || count_value > 1e7 || std::floor(count_value) != count_value) {
     throw Error(option + ": COUNT must be a whole number from 1 to 10^7, got " + parts[2]);
@@ -143,7 +147,8 @@ std::string radial_profile_csv(const Material& material, const RadialProfileOpti
   };
   for (double r : options.r_mm) {
     out << format_input(r);
-    for (int channel = 0; channel < 3; ++channel) out << ',' << format_number(radial_value(channel, r));
+    for (int channel = 0; channel < 3; ++channel)
+      out << ',' << format_number(radial_value(channel, r));
     out << '\n';
   }
   if (options.total) {
@@ -156,8 +161,8 @@ std::string radial_profile_csv(const Material& material, const RadialProfileOpti
       } else {
         const auto c = derive_coefficients(medium);
         if (c.scatters()) {
-          total = integrate_over_plane([&](double r) { return radial_value(channel, r); },
-                                       c.z_r, 1e-9);
+          total =
+              integrate_over_plane([&](double r) { return radial_value(channel, r); }, c.z_r, 1e-9);
         }
       }
       out << ',' << format_number(total);
@@ -200,8 +205,11 @@ std::vector<BssrdfConfig> read_bssrdf_configs(std::istream& in, const std::strin
                     fields[i] + "'");
       }
     }
-    BssrdfConfig c{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}, {v[6], v[7], v[8]},
-                   {v[9], v[10], v[11]}, {v[12], v[13], v[14]}};
+    BssrdfConfig c{{v[0], v[1], v[2]},
+                   {v[3], v[4], v[5]},
+                   {v[6], v[7], v[8]},
+                   {v[9], v[10], v[11]},
+                   {v[12], v[13], v[14]}};
     const std::pair<const Vec3<double>*, const char*> units[] = {
         {&c.n_i, "ni"}, {&c.w_i, "wi"}, {&c.n_o, "no"}};
     for (const auto& [vector, name] : units) {

@@ -70,7 +70,8 @@ double integrate(const std::function<double(double)>& f, double a, double b, dou
 double integrate_over_plane(const std::function<double(double)>& f, double length_scale_mm,
                             double rel_tol) {
   const auto integrand = [&](double r) { return 2.0 * std::numbers::pi * r * f(r); };
-  // Panels [0, s], [s, 2s], [2s, 4s], ...: fine where the profile is steep, growing where it decays.
+  // Panels [0, s], [s, 2s], [2s, 4s], ...: fine where the profile is steep, growing where it
+  // decays.
   double total = integrate(integrand, 0.0, length_scale_mm, rel_tol * 0.1);
   double a = length_scale_mm;
   int small_panels = 0;

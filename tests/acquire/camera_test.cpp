@@ -62,8 +62,8 @@ TEST(Camera, ShotNoiseHasPoissonVariance) {
   }
   const double n = double(image.data.size());
   const double mean = sum / n, var = sum2 / n - mean * mean;
-  EXPECT_NEAR(mean, 100.0, 0.2);   // SE of the mean: 10 / sqrt(120000) = 0.03
-  EXPECT_NEAR(var, 100.0, 2.0);    // SE of the variance: 100 sqrt(2 / n) = 0.4
+  EXPECT_NEAR(mean, 100.0, 0.2);  // SE of the mean: 10 / sqrt(120000) = 0.03
+  EXPECT_NEAR(var, 100.0, 2.0);   // SE of the variance: 100 sqrt(2 / n) = 0.4
 }
 
 TEST(Camera, StreamsAreDeterministicAndDistinct) {

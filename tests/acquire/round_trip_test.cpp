@@ -15,7 +15,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path fresh_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("lucent-rt-" + name + "-" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("lucent-rt-" + name + "-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   return dir;
 }
@@ -50,17 +51,21 @@ TEST(RoundTrip, SimulateThenAcquireRecoversTheRadianceInAbsoluteUnits) {
       int n = 0;
       for (int j = 0; j < truth.height; ++j) {
         for (int i = 0; i < truth.width; ++i) {
-          const double r = 0.25 * std::hypot(i + 0.5 - profile.beam_point_px[0], j + 0.5 - profile.beam_point_px[1]);
+          const double r = 0.25 * std::hypot(i + 0.5 - profile.beam_point_px[0],
+                                             j + 0.5 - profile.beam_point_px[1]);
           const bool last = b + 1 == profile.radial.size();
-          if (r >= profile.radial.r_inner_mm[b] && (r < profile.radial.r_outer_mm[b] || (last && r <= profile.radial.r_outer_mm[b]))) {
+          if (r >= profile.radial.r_inner_mm[b] &&
+              (r < profile.radial.r_outer_mm[b] || (last && r <= profile.radial.r_outer_mm[b]))) {
             sum += truth.at(i, j, c);
             ++n;
           }
         }
       }
-      if (n != profile.radial.count[c][b]) continue;  // a masked pixel changed the set: skip the bin
+      if (n != profile.radial.count[c][b])
+        continue;  // a masked pixel changed the set: skip the bin
       const double expected = std::numbers::pi * sum / n;
-      const double z = (profile.radial.value[c][b] - expected) / profile.radial.standard_error[c][b];
+      const double z =
+          (profile.radial.value[c][b] - expected) / profile.radial.standard_error[c][b];
       ++bins;
       within += std::abs(z) < 4;
     }

@@ -16,7 +16,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path fresh_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("lucent-sim-" + name + "-" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("lucent-sim-" + name + "-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   return dir;
 }
@@ -104,7 +105,8 @@ TEST(Simulate, BadOptionsLeaveNoFolder) {
   EXPECT_FALSE(fs::exists(dir));
   // Nothing stray beside it either.
   for (const auto& entry : fs::directory_iterator(dir.parent_path())) {
-    EXPECT_EQ(entry.path().filename().string().find("." + dir.filename().string()), std::string::npos);
+    EXPECT_EQ(entry.path().filename().string().find("." + dir.filename().string()),
+              std::string::npos);
   }
 }
 
@@ -112,7 +114,8 @@ TEST(Simulate, ProfileOnlyWritesTruthAndExitance) {
   const fs::path dir = fresh_dir("profile-only");
   SimulateOptions o = small_marble();
   o.profile_only = true;
-  const fs::path csv = fs::temp_directory_path() / ("lucent-exitance-" + std::to_string(::getpid()) + ".csv");
+  const fs::path csv =
+      fs::temp_directory_path() / ("lucent-exitance-" + std::to_string(::getpid()) + ".csv");
   o.exitance_csv = csv;
   run_simulation(o, dir);
   EXPECT_TRUE(fs::exists(dir / "truth.json"));

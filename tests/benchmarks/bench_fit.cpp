@@ -6,10 +6,10 @@
 #include <cmath>
 #include <random>
 
+#include <numbers>
 #include "lucent/fit/fit.h"
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/directional_dipole.h"
-#include <numbers>
 #include "lucent/materials/fresnel.h"
 
 namespace {
@@ -46,7 +46,9 @@ void BM_DipoleFit150Bins(benchmark::State& state) {
   o.model = fit::FitModel::kDipole;
   o.quality = static_cast<fit::Quality>(state.range(0));
   o.analytic_derivatives = state.range(1) != 0;
-  state.SetLabel(std::string(state.range(0) == 0 ? "fast" : state.range(0) == 1 ? "balanced" : "accurate") +
+  state.SetLabel(std::string(state.range(0) == 0   ? "fast"
+                             : state.range(0) == 1 ? "balanced"
+                                                   : "accurate") +
                  (o.analytic_derivatives ? ", analytic" : ", autodiff"));
   for (auto _ : state) {
     const fit::FitResult r = fit::fit_profiles({d}, o);
@@ -55,8 +57,8 @@ void BM_DipoleFit150Bins(benchmark::State& state) {
 }
 BENCHMARK(BM_DipoleFit150Bins)->ArgsProduct({{0, 1, 2}, {0, 1}})->Unit(benchmark::kMicrosecond);
 
-// A 128 x 128 oblique capture (45 degrees, 0.25 mm pixels) of marble made by the directional dipole,
-// 1% noise: the directional-dipole fit's speed target (under 0.5 s).
+// A 128 x 128 oblique capture (45 degrees, 0.25 mm pixels) of marble made by the directional
+// dipole, 1% noise: the directional-dipole fit's speed target (under 0.5 s).
 fit::ProfileData oblique_capture() {
   const materials::Material m = materials::load_material("marble");
   fit::ProfileData d;
@@ -65,7 +67,8 @@ fit::ProfileData oblique_capture() {
   d.incidence_polar_deg = 45;
   const double th = std::numbers::pi / 4;
   const materials::Vec3<double> w_i(-std::sin(th), 0, std::cos(th)), up(0, 0, 1);
-  const double ft = materials::fresnel_transmittance(std::cos(th), m.ior) * materials::fresnel_transmittance(1.0, m.ior);
+  const double ft = materials::fresnel_transmittance(std::cos(th), m.ior) *
+                    materials::fresnel_transmittance(1.0, m.ior);
   std::mt19937 rng(5);
   std::normal_distribution<double> noise(0.0, 0.01);
   fit::Samples2d s;
@@ -77,8 +80,8 @@ fit::ProfileData oblique_capture() {
       s.y_mm.push_back(y);
       for (int c = 0; c < 3; ++c) {
         const double v = ft * std::numbers::pi *
-                         materials::DirectionalDipole<double>(m.medium(c)).S_d(
-                             materials::Vec3<double>::Zero(), up, w_i, {x, y, 0.0}, up);
+                         materials::DirectionalDipole<double>(m.medium(c))
+                             .S_d(materials::Vec3<double>::Zero(), up, w_i, {x, y, 0.0}, up);
         s.value[c].push_back(v * (1 + noise(rng)));
         s.standard_error[c].push_back(0.01 * v);
       }

@@ -26,8 +26,8 @@ inline std::string read_text(const std::filesystem::path& path) {
 
 /// A fresh, empty folder for one test.
 inline std::filesystem::path scratch_dir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("lucent-test-" + name + "-" +
-                                                             std::to_string(::getpid()));
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("lucent-test-" + name + "-" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;

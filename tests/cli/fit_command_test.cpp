@@ -31,9 +31,10 @@ std::string good_csv() {
 TEST(FitCommand, FitsACsvProfileAndWritesMaterialPlotAndReport) {
   const fs::path dir = scratch_dir("fit-good");
   write_csv(dir / "p.csv", good_csv());
-  const auto r = run_lucent("fit \"" + (dir / "p.csv").string() + "\" --ior 1.5 --model dipole -o \"" +
-                            (dir / "m.json").string() + "\" --plot \"" + (dir / "fit.png").string() +
-                            "\" --report \"" + (dir / "report.json").string() + "\" --exclude-radius-mm 0");
+  const auto r =
+      run_lucent("fit \"" + (dir / "p.csv").string() + "\" --ior 1.5 --model dipole -o \"" +
+                 (dir / "m.json").string() + "\" --plot \"" + (dir / "fit.png").string() +
+                 "\" --report \"" + (dir / "report.json").string() + "\" --exclude-radius-mm 0");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir / "fit.png"));
   EXPECT_TRUE(fs::exists(dir / "report.json"));
@@ -52,7 +53,9 @@ struct BadFit {
   const char* message;
 };
 
-void PrintTo(const BadFit& b, std::ostream* os) { *os << b.name; }
+void PrintTo(const BadFit& b, std::ostream* os) {
+  *os << b.name;
+}
 
 class FitCommandBadInput : public ::testing::TestWithParam<BadFit> {};
 
@@ -62,8 +65,10 @@ TEST_P(FitCommandBadInput, OneLineNonZeroExitNoOutput) {
   const fs::path in = dir / "in.csv", out = dir / "out.json";
   if (!bad.csv.empty()) write_csv(in, bad.csv);
   std::string args = bad.args;
-  for (const auto& [key, value] : {std::pair{std::string("{IN}"), in.string()}, {std::string("{OUT}"), out.string()}}) {
-    for (auto pos = args.find(key); pos != std::string::npos; pos = args.find(key)) args.replace(pos, key.size(), value);
+  for (const auto& [key, value] :
+       {std::pair{std::string("{IN}"), in.string()}, {std::string("{OUT}"), out.string()}}) {
+    for (auto pos = args.find(key); pos != std::string::npos; pos = args.find(key))
+      args.replace(pos, key.size(), value);
   }
   const auto r = run_lucent(args, bad.name);
   EXPECT_NE(r.exit_code, 0) << bad.name;
@@ -78,17 +83,20 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         BadFit{"csv_without_ior", good_csv(), "fit {IN} -o {OUT}", "--ior"},
         BadFit{"empty_profile", "r_mm,R,se\n", "fit {IN} --ior 1.5 -o {OUT}", "empty"},
-        BadFit{"too_few_samples", "r_mm,R,se\n1,0.03,0.001\n", "fit {IN} --ior 1.5 --exclude-radius-mm 0 -o {OUT}",
-               "usable samples"},
+        BadFit{"too_few_samples", "r_mm,R,se\n1,0.03,0.001\n",
+               "fit {IN} --ior 1.5 --exclude-radius-mm 0 -o {OUT}", "usable samples"},
         BadFit{"non_positive_values", "r_mm,R,se\n1,-0.03,0.001\n2,-0.01,0.001\n3,0,0.001\n",
                "fit {IN} --ior 1.5 --exclude-radius-mm 0 -o {OUT}", "usable samples"},
         BadFit{"nan_value", "r_mm,R,se\n1,nan,0.001\n2,0.01,0.001\n", "fit {IN} --ior 1.5 -o {OUT}",
                "line 2: column R: expected a finite number"},
-        BadFit{"unknown_model", good_csv(), "fit {IN} --ior 1.5 --model tripole -o {OUT}", "--model: expected"},
+        BadFit{"unknown_model", good_csv(), "fit {IN} --ior 1.5 --model tripole -o {OUT}",
+               "--model: expected"},
         BadFit{"bad_loss", good_csv(), "fit {IN} --ior 1.5 --loss huber:x -o {OUT}", "--loss"},
-        BadFit{"bad_quality", good_csv(), "fit {IN} --ior 1.5 --quality best -o {OUT}", "--quality"},
+        BadFit{"bad_quality", good_csv(), "fit {IN} --ior 1.5 --quality best -o {OUT}",
+               "--quality"},
         BadFit{"missing_input", "", "fit {IN} --ior 1.5 -o {OUT}", "cannot open"},
-        BadFit{"bad_header", "x,y\n1,2\n", "fit {IN} --ior 1.5 -o {OUT}", "expected a header with r_mm"}),
+        BadFit{"bad_header", "x,y\n1,2\n", "fit {IN} --ior 1.5 -o {OUT}",
+               "expected a header with r_mm"}),
     [](const ::testing::TestParamInfo<BadFit>& info) { return std::string(info.param.name); });
 
 }  // namespace

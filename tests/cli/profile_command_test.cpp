@@ -28,8 +28,8 @@ std::vector<std::vector<std::string>> parse_csv(const std::string& text) {
   return rows;
 }
 
-// Same header, same labels, numbers equal to 1e-12 relative: goldens survive last-bit differences in
-// libm between machines but catch any change of formula.
+// Same header, same labels, numbers equal to 1e-12 relative: goldens survive last-bit differences
+// in libm between machines but catch any change of formula.
 void expect_csv_matches_golden(const std::string& actual, const std::string& golden_name) {
   const std::string golden = read_text(kData + "/golden/" + golden_name);
   ASSERT_FALSE(golden.empty()) << "missing golden " << golden_name;
@@ -52,14 +52,16 @@ void expect_csv_matches_golden(const std::string& actual, const std::string& gol
 }
 
 TEST(ProfileCommand, DipoleRadiiMatchGolden) {
-  const auto r = run_lucent("profile --material marble --model dipole --r 0,0.1,0.5,1,2,10 --total");
+  const auto r =
+      run_lucent("profile --material marble --model dipole --r 0,0.1,0.5,1,2,10 --total");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.err.empty()) << r.err;
   expect_csv_matches_golden(r.out, "marble_dipole_radii.csv");
 }
 
 TEST(ProfileCommand, DirectionalDipoleRangeMatchesGolden) {
-  const auto r = run_lucent("profile --material marble --model ddipole --r-range 0.01:50:20:log --total");
+  const auto r =
+      run_lucent("profile --material marble --model ddipole --r-range 0.01:50:20:log --total");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   expect_csv_matches_golden(r.out, "marble_ddipole_range.csv");
 }
@@ -86,8 +88,10 @@ TEST(ProfileCommand, MaterialFromAFilePath) {
 }
 
 TEST(ProfileCommand, DipoleTotalEqualsClosedFormAndDdipoleExceedsIt) {
-  const auto dipole = parse_csv(run_lucent("profile --material marble --model dipole --r 1 --total").out);
-  const auto ddipole = parse_csv(run_lucent("profile --material marble --model ddipole --r 1 --total").out);
+  const auto dipole =
+      parse_csv(run_lucent("profile --material marble --model dipole --r 1 --total").out);
+  const auto ddipole =
+      parse_csv(run_lucent("profile --material marble --model ddipole --r 1 --total").out);
   ASSERT_EQ(dipole.back()[0], "total");
   ASSERT_EQ(ddipole.back()[0], "total");
   EXPECT_NEAR(std::stod(dipole.back()[1]), 0.8301914562772919, 1e-12);
@@ -100,7 +104,9 @@ struct BadInput {
   const char* message;  // expected substring of the single error line
 };
 
-void PrintTo(const BadInput& bad, std::ostream* os) { *os << bad.name; }
+void PrintTo(const BadInput& bad, std::ostream* os) {
+  *os << bad.name;
+}
 
 class ProfileCommandBadInput : public ::testing::TestWithParam<BadInput> {};
 
@@ -141,7 +147,8 @@ INSTANTIATE_TEST_SUITE_P(
                  "excludes"},
         BadInput{"missing_configs", "profile --material marble --configs {DATA}/nope.csv -o {OUT}",
                  "cannot open"},
-        BadInput{"malformed_row", "profile --material marble --configs {DATA}/malformed_row.csv -o {OUT}",
+        BadInput{"malformed_row",
+                 "profile --material marble --configs {DATA}/malformed_row.csv -o {OUT}",
                  "malformed_row.csv: line 3: column wi_y: expected a finite number"},
         BadInput{"short_row", "profile --material marble --configs {DATA}/short_row.csv -o {OUT}",
                  "short_row.csv: line 2: expected 15 comma-separated numbers"},
@@ -150,8 +157,8 @@ INSTANTIATE_TEST_SUITE_P(
                  "non_unit_normal.csv: line 2: ni must be a unit vector"},
         BadInput{"bad_header", "profile --material marble --configs {DATA}/bad_header.csv -o {OUT}",
                  "bad_header.csv: line 1: expected the header"},
-        BadInput{"bad_material_file",
-                 "profile --material {DATA}/bad_material.json --r 1 -o {OUT}", "bad_material.json"},
+        BadInput{"bad_material_file", "profile --material {DATA}/bad_material.json --r 1 -o {OUT}",
+                 "bad_material.json"},
         BadInput{"unwritable_output", "profile --material marble --r 1 -o {DATA}/no/such/dir/x.csv",
                  "no/such/dir/x.csv"}),
     [](const ::testing::TestParamInfo<BadInput>& info) { return std::string(info.param.name); });

@@ -20,7 +20,8 @@ TEST(DipoleGradient, MatchesTheModelAndItsAutomaticDerivatives) {
     for (int c = 0; c < 3; ++c) {
       const detail::DipoleGradientModel model(m.sigma_a[c], m.sigma_s_reduced[c], m.ior);
       const materials::StandardDipole<Jet> jet(materials::Medium<Jet>::from_reduced(
-          exp(Jet(std::log(m.sigma_a[c]), 0)), exp(Jet(std::log(m.sigma_s_reduced[c]), 1)), Jet(m.ior)));
+          exp(Jet(std::log(m.sigma_a[c]), 0)), exp(Jet(std::log(m.sigma_s_reduced[c]), 1)),
+          Jet(m.ior)));
       for (double r : {0.0, 0.01, 0.3, 1.0, 4.0, 25.0}) {
         const detail::DipoleGradient g = model.at(r);
         const Jet expected = jet.R_d(Jet(r));
@@ -43,8 +44,8 @@ TEST(DipoleGradient, AnalyticAndAutomaticFitsAgree) {
     d.radial.r_outer_mm.push_back(r1);
     d.radial.r_mm.push_back(0.5 * (r0 + r1));
     for (int c = 0; c < 3; ++c) {
-      // A profile the model cannot match exactly (a 3% ripple), so the two solutions are compared at
-      // a non-trivial minimum.
+      // A profile the model cannot match exactly (a 3% ripple), so the two solutions are compared
+      // at a non-trivial minimum.
       const double v = materials::StandardDipole<double>(m.medium(c)).R_d(0.5 * (r0 + r1)) *
                        (1 + 0.03 * std::sin(1.7 * i));
       d.radial.value[c].push_back(v);

@@ -1,6 +1,6 @@
 // The reported standard deviations are honest: model-made radiance images through the camera model
-// (noise on), acquired and fitted for 20 seeds; the truth lies within 2 reported standard deviations
-// in about 95% of the fits, within 1 in about 68%.
+// (noise on), acquired and fitted for 20 seeds; the truth lies within 2 reported standard
+// deviations in about 95% of the fits, within 1 in about 68%.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -19,8 +19,10 @@ TEST(FitNoise, StandardDeviationsAreHonestOverTwentySeeds) {
   const materials::Material truth = materials::load_material("potato");
   int checks = 0, within_1 = 0, within_2 = 0;
   for (int seed = 1; seed <= 20; ++seed) {
-    const fs::path sim = fs::temp_directory_path() / ("lucent-noise-sim-" + std::to_string(::getpid()));
-    const fs::path acq = fs::temp_directory_path() / ("lucent-noise-acq-" + std::to_string(::getpid()));
+    const fs::path sim =
+        fs::temp_directory_path() / ("lucent-noise-sim-" + std::to_string(::getpid()));
+    const fs::path acq =
+        fs::temp_directory_path() / ("lucent-noise-acq-" + std::to_string(::getpid()));
     fs::remove_all(sim);
     fs::remove_all(acq);
     acquire::SimulateOptions o;
@@ -53,9 +55,11 @@ TEST(FitNoise, StandardDeviationsAreHonestOverTwentySeeds) {
     fs::remove_all(sim);
     fs::remove_all(acq);
   }
-  std::printf("truth within 1 SD in %d of %d, within 2 SD in %d of %d\n", within_1, checks, within_2, checks);
+  std::printf("truth within 1 SD in %d of %d, within 2 SD in %d of %d\n", within_1, checks,
+              within_2, checks);
   // Binomial with p = 0.95 over 120 checks: mean 114, sd 2.4; 105 is nearly 4 sd below. The 1-SD
-  // count (p = 0.68: mean 82, sd 5) guards the other side: errors inflated to be safe are not honest.
+  // count (p = 0.68: mean 82, sd 5) guards the other side: errors inflated to be safe are not
+  // honest.
   EXPECT_GE(within_2, 105);
   EXPECT_GE(within_1, 62);
   EXPECT_LE(within_1, 102);

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <numbers>
 
-
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/directional_dipole.h"
 #include "lucent/materials/error.h"
@@ -37,7 +36,8 @@ ProfileData model_profile(const materials::Material& m, FitModel model, int bins
     d.radial.r_inner_mm.push_back(r);
     d.radial.r_outer_mm.push_back(r);
     for (int c = 0; c < 3; ++c) {
-      const Medium<double> medium = Medium<double>::from_reduced(m.sigma_a[c], m.sigma_s_reduced[c], m.ior);
+      const Medium<double> medium =
+          Medium<double>::from_reduced(m.sigma_a[c], m.sigma_s_reduced[c], m.ior);
       double v = 0;
       if (d.channels[c]) {
         if (model == FitModel::kDipole) {
@@ -73,7 +73,8 @@ TEST_P(ExactRecovery, BothModelsFromStartValuesTenTimesOff) {
       if (!materials::derive_coefficients(m.medium(c)).scatters()) continue;
       EXPECT_NEAR(r.chosen.channels[c].sigma_a, m.sigma_a[c], 1e-4 * m.sigma_a[c])
           << GetParam() << " channel " << c << " model " << int(model);
-      EXPECT_NEAR(r.chosen.channels[c].sigma_s_reduced, m.sigma_s_reduced[c], 1e-4 * m.sigma_s_reduced[c])
+      EXPECT_NEAR(r.chosen.channels[c].sigma_s_reduced, m.sigma_s_reduced[c],
+                  1e-4 * m.sigma_s_reduced[c])
           << GetParam() << " channel " << c << " model " << int(model);
     }
   }
@@ -110,8 +111,9 @@ TEST(Fit, RelativeProfileRecoversTheScale) {
 }
 
 TEST(Fit, UncertaintyIsReportedAndFiniteForAGoodFit) {
-  const FitResult r = fit_profiles({model_profile(materials::load_material("marble"), FitModel::kDipole)},
-                                   FitOptions{.model = FitModel::kDipole});
+  const FitResult r =
+      fit_profiles({model_profile(materials::load_material("marble"), FitModel::kDipole)},
+                   FitOptions{.model = FitModel::kDipole});
   for (const ChannelFit& c : r.chosen.channels) {
     EXPECT_GT(c.sd_sigma_a, 0.0);
     EXPECT_GT(c.sd_sigma_s_reduced, 0.0);
@@ -122,8 +124,8 @@ TEST(Fit, UncertaintyIsReportedAndFiniteForAGoodFit) {
 }
 
 TEST(Fit, ScaleAndAlbedoTogetherAreUndeterminedInTheFarFieldOnly) {
-  // Far-field samples of a relative profile fix sigma_tr but not sigma_a and sigma_s' apart from the
-  // scale: the fit must say so rather than crash or report tiny errors.
+  // Far-field samples of a relative profile fix sigma_tr but not sigma_a and sigma_s' apart from
+  // the scale: the fit must say so rather than crash or report tiny errors.
   const materials::Material m = materials::load_material("marble");
   ProfileData d = model_profile(m, FitModel::kDipole);
   d.calibrated = false;
@@ -146,7 +148,8 @@ TEST(Fit, UnconvergedFitSaysSoUnlessAllowed) {
   o.start = start;
   ProfileData d = model_profile(m, FitModel::kDipole);
   for (int c = 0; c < 3; ++c) {  // a profile the model cannot fit exactly: the solver must iterate
-    for (std::size_t i = 0; i < d.radial.size(); ++i) d.radial.value[c][i] *= 1 + 0.05 * std::sin(double(i));
+    for (std::size_t i = 0; i < d.radial.size(); ++i)
+      d.radial.value[c][i] *= 1 + 0.05 * std::sin(double(i));
   }
   try {
     fit_profiles({d}, o);
@@ -161,16 +164,20 @@ TEST(Fit, UnconvergedFitSaysSoUnlessAllowed) {
 }
 
 // A 2D oblique profile made by the directional dipole itself (pixel centres, no noise).
-ProfileData oblique_profile(const materials::Material& m, double incidence_deg, double azimuth_deg) {
+ProfileData oblique_profile(const materials::Material& m, double incidence_deg,
+                            double azimuth_deg) {
   ProfileData d;
   d.source = "model-oblique";
   d.eta = m.ior;
   d.incidence_polar_deg = incidence_deg;
   d.incidence_azimuth_deg = azimuth_deg;
-  const double th = incidence_deg * std::numbers::pi / 180, ph = azimuth_deg * std::numbers::pi / 180;
-  const materials::Vec3<double> w_i(-std::sin(th) * std::cos(ph), -std::sin(th) * std::sin(ph), std::cos(th));
+  const double th = incidence_deg * std::numbers::pi / 180,
+               ph = azimuth_deg * std::numbers::pi / 180;
+  const materials::Vec3<double> w_i(-std::sin(th) * std::cos(ph), -std::sin(th) * std::sin(ph),
+                                    std::cos(th));
   const materials::Vec3<double> up(0, 0, 1);
-  const double ft = materials::fresnel_transmittance(std::cos(th), m.ior) * materials::fresnel_transmittance(1.0, m.ior);
+  const double ft = materials::fresnel_transmittance(std::cos(th), m.ior) *
+                    materials::fresnel_transmittance(1.0, m.ior);
   Samples2d s;
   for (int j = 0; j < 24; ++j) {
     for (int i = 0; i < 24; ++i) {
@@ -179,8 +186,8 @@ ProfileData oblique_profile(const materials::Material& m, double incidence_deg, 
       s.y_mm.push_back(y);
       for (int c = 0; c < 3; ++c) {
         const double v = ft * std::numbers::pi *
-                         materials::DirectionalDipole<double>(m.medium(c)).S_d(
-                             materials::Vec3<double>::Zero(), up, w_i, {x, y, 0.0}, up);
+                         materials::DirectionalDipole<double>(m.medium(c))
+                             .S_d(materials::Vec3<double>::Zero(), up, w_i, {x, y, 0.0}, up);
         s.value[c].push_back(v);
         s.standard_error[c].push_back(0.01 * v + 1e-300);
       }
@@ -199,7 +206,8 @@ TEST(Fit, ObliqueCapturesFitJointlyWithTheDirectionalDipole) {
   EXPECT_EQ(r.chosen.model, FitModel::kDirectionalDipole) << r.reason;
   for (int c = 0; c < 3; ++c) {
     EXPECT_NEAR(r.chosen.channels[c].sigma_a, m.sigma_a[c], 1e-4 * m.sigma_a[c]);
-    EXPECT_NEAR(r.chosen.channels[c].sigma_s_reduced, m.sigma_s_reduced[c], 1e-4 * m.sigma_s_reduced[c]);
+    EXPECT_NEAR(r.chosen.channels[c].sigma_s_reduced, m.sigma_s_reduced[c],
+                1e-4 * m.sigma_s_reduced[c]);
     EXPECT_EQ(r.chosen.channels[c].samples, 2 * 24 * 24);
   }
 }

@@ -24,7 +24,8 @@ TEST(Albedo, DiffuseColourAndMeanFreePathRoundTrip) {
   for (double colour : {0.05, 0.4, 0.83, 0.97}) {
     for (double mfp : {0.1, 1.0, 8.5}) {
       const ReducedCoefficients c = coefficients_from_diffuse_colour(colour, mfp, 1.5);
-      const StandardDipole<double> dipole(Medium<double>::from_reduced(c.sigma_a, c.sigma_s_reduced, 1.5));
+      const StandardDipole<double> dipole(
+          Medium<double>::from_reduced(c.sigma_a, c.sigma_s_reduced, 1.5));
       EXPECT_NEAR(dipole.total_diffuse_reflectance(), colour, 1e-10);
       EXPECT_NEAR(1.0 / dipole.coefficients().sigma_tr, mfp, 1e-9 * mfp);
     }

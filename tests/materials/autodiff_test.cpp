@@ -63,8 +63,12 @@ TEST(Autodiff, DipoleTotalReflectance) {
 TEST(Autodiff, DirectionalDipoleObliqueAndCoincident) {
   const double p[3] = {std::log(0.0090), std::log(0.70), 1.3};
   const double w = std::sqrt(0.5);
-  struct Geometry { double xo[3]; double wi[3]; };
-  const Geometry cases[] = {{{1.0, 0.3, 0}, {-w, 0, w}}, {{0, 0, 0}, {0, 0, 1}},
+  struct Geometry {
+    double xo[3];
+    double wi[3];
+  };
+  const Geometry cases[] = {{{1.0, 0.3, 0}, {-w, 0, w}},
+                            {{0, 0, 0}, {0, 0, 1}},
                             {{-2.5, 1.0, 0}, {0.2, 0.1, std::sqrt(0.95)}}};
   for (const Geometry& g : cases) {
     expect_gradient_matches(

@@ -17,7 +17,9 @@ namespace {
 using V = Vec3<double>;
 const V kUp(0, 0, 1);
 
-Medium<double> marble_red() { return Medium<double>::from_reduced(0.0021, 2.19, 1.5); }
+Medium<double> marble_red() {
+  return Medium<double>::from_reduced(0.0021, 2.19, 1.5);
+}
 
 TEST(DirectionalDipole, MatchesIndependentTranscriptionOfTheSampleCode) {
   // golden/make_golden.py re-implements the authors' sample code in plain Python.
@@ -76,8 +78,7 @@ TEST(DirectionalDipole, RigidMotionsLeaveItUnchanged) {
     const V x_o = x_i + random_unit() * std::exp(uniform(rng));
     const V n_o = random_unit();
     const double S = dd.S_d(x_i, n_i, w_i, x_o, n_o);
-    const Eigen::Matrix3d R =
-        Eigen::AngleAxisd(uniform(rng), random_unit()).toRotationMatrix();
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(uniform(rng), random_unit()).toRotationMatrix();
     const V t(uniform(rng), uniform(rng), uniform(rng));
     const double S_moved = dd.S_d(R * x_i + t, R * n_i, R * w_i, R * x_o + t, R * n_o);
     EXPECT_NEAR(S_moved, S, 1e-12 * S + 1e-300) << "configuration " << i;
@@ -124,8 +125,8 @@ TEST(DirectionalDipole, ObliqueIncidenceShiftsLightForward) {
 }
 
 TEST(DirectionalDipole, TotalReflectanceExceedsTheDipoleByTheKnownMargin) {
-  // DESIGN §4.1: for albedo near 1 the reference formulation overestimates total diffuse reflectance
-  // by 20-30% against Monte Carlo, where the standard dipole is within 1-2%.
+  // DESIGN §4.1: for albedo near 1 the reference formulation overestimates total diffuse
+  // reflectance by 20-30% against Monte Carlo, where the standard dipole is within 1-2%.
   const Medium<double> medium = marble_red();
   const DirectionalDipole<double> dd(medium);
   const double total = integrate_over_plane(

@@ -18,9 +18,9 @@ struct SweepCase {
 };
 
 // Draws media and geometries over the whole range the models are asked to survive: r from 1e-6 to
-// 1e4 mean free paths (and exactly 0), reduced albedo from 1e-6 to 1 - 1e-8, eta from 1.0 to 2.5 (and
-// below 1), grazing incidence, back-lit points (n_o facing away from the light's refracted path),
-// coincident points, x_o straight below x_i.
+// 1e4 mean free paths (and exactly 0), reduced albedo from 1e-6 to 1 - 1e-8, eta from 1.0 to 2.5
+// (and below 1), grazing incidence, back-lit points (n_o facing away from the light's refracted
+// path), coincident points, x_o straight below x_i.
 class Sweep {
  public:
   explicit Sweep(std::uint64_t seed) : rng_(seed) {}
@@ -106,7 +106,9 @@ class Sweep {
 };
 
 template <typename T>
-Vec3<T> cast(const Vec3<double>& v) { return v.cast<T>(); }
+Vec3<T> cast(const Vec3<double>& v) {
+  return v.cast<T>();
+}
 
 TEST(Stability, NoNanOrInfOnAMillionConfigurations) {
   Sweep sweep(2026);
@@ -119,8 +121,8 @@ TEST(Stability, NoNanOrInfOnAMillionConfigurations) {
     const StandardDipole<double> dipole(c.medium);
     const double R = dipole.R_d((c.x_o - c.x_i).norm());
     ASSERT_TRUE(std::isfinite(R) && R >= 0) << c.kind << " " << c.medium.to_string() << " R=" << R;
-    const DirectionalDipole<float> dd_f(Medium<float>{float(c.medium.sigma_a),
-        float(c.medium.sigma_s), float(c.medium.g), float(c.medium.eta)});
+    const DirectionalDipole<float> dd_f(Medium<float>{
+        float(c.medium.sigma_a), float(c.medium.sigma_s), float(c.medium.g), float(c.medium.eta)});
     const float S_f = dd_f.S_d(cast<float>(c.x_i), cast<float>(c.n_i), cast<float>(c.w_i),
                                cast<float>(c.x_o), cast<float>(c.n_o));
     ASSERT_TRUE(std::isfinite(S_f) && S_f >= 0) << c.kind << " " << c.medium.to_string();
@@ -136,10 +138,10 @@ namespace lucent::materials {
 namespace {
 
 // How far the double result moves when every input is nudged by a few float roundings (relative
-// 4 * 2^-24, the size of the rounding a float evaluation accumulates in w_r, n_i* and mu0 before they
-// meet the formula): an error no float formulation can avoid. It is large next to the clamp at 0
-// (S is a difference of two sources) and where the real source nears x_o (mu0 -> 0 at r -> 0,
-// S ~ 1/mu0^3).
+// 4 * 2^-24, the size of the rounding a float evaluation accumulates in w_r, n_i* and mu0 before
+// they meet the formula): an error no float formulation can avoid. It is large next to the clamp at
+// 0 (S is a difference of two sources) and where the real source nears x_o (mu0 -> 0 at r -> 0, S ~
+// 1/mu0^3).
 double float_rounding_sensitivity(const SweepCase& c, double S, std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const double eps = 4.0 * std::ldexp(1.0, -24);
@@ -154,8 +156,8 @@ double float_rounding_sensitivity(const SweepCase& c, double S, std::mt19937_64&
     const Vec3<double> x_i = nudge3(c.x_i);
     // x_o keeps its offset from x_i exact, as the float evaluation does (x_o - x_i is exact there).
     const Vec3<double> x_o = x_i + nudge3(c.x_o - c.x_i);
-    const double S_k = DirectionalDipole<double>(m).S_d(x_i, nudge3(c.n_i), nudge3(c.w_i), x_o,
-                                                        nudge3(c.n_o));
+    const double S_k =
+        DirectionalDipole<double>(m).S_d(x_i, nudge3(c.n_i), nudge3(c.w_i), x_o, nudge3(c.n_o));
     worst = std::max(worst, std::abs(S_k - S) / S);
   }
   return worst;
@@ -181,9 +183,9 @@ TEST(Stability, FloatAgreesWithDouble) {
     round_to_float(c.x_o);
     round_to_float(c.n_o);
     const double S = DirectionalDipole<double>(c.medium).S_d(c.x_i, c.n_i, c.w_i, c.x_o, c.n_o);
-    const float S_f = DirectionalDipole<float>(mf).S_d(cast<float>(c.x_i), cast<float>(c.n_i),
-                                                       cast<float>(c.w_i), cast<float>(c.x_o),
-                                                       cast<float>(c.n_o));
+    const float S_f =
+        DirectionalDipole<float>(mf).S_d(cast<float>(c.x_i), cast<float>(c.n_i), cast<float>(c.w_i),
+                                         cast<float>(c.x_o), cast<float>(c.n_o));
     if (S > 1e-30) {
       ++compared;
       const double e = std::abs(S_f - S) / S;
@@ -208,10 +210,11 @@ TEST(Stability, FloatAgreesWithDouble) {
       worst_dipole = std::max(worst_dipole, e);
     }
   }
-  std::printf("ddipole: %d compared (value > 1e-30), %d within 1e-4, %d beyond but within what "
-              "float rounding of the inputs causes, %d neither\n"
-              "dipole: worst relative error %.3g, %d above 1e-4\n",
-              compared, within_1e4, within_conditioning, bad_dd, worst_dipole, bad_dipole);
+  std::printf(
+      "ddipole: %d compared (value > 1e-30), %d within 1e-4, %d beyond but within what "
+      "float rounding of the inputs causes, %d neither\n"
+      "dipole: worst relative error %.3g, %d above 1e-4\n",
+      compared, within_1e4, within_conditioning, bad_dd, worst_dipole, bad_dipole);
   EXPECT_EQ(bad_dd, 0);
   EXPECT_EQ(bad_dipole, 0);
   EXPECT_GT(compared, 600000);

@@ -15,11 +15,12 @@ struct CameraOptions {
   std::vector<double> exposures_s = {1.0 / 1000, 1.0 / 250, 1.0 / 60, 1.0 / 15, 1.0 / 4};
   /// Code-value encoding: kLinear or kSrgb (kCalibrate is a way to read, not a camera).
   Response response = Response::kSrgb;
-  int bits = 16;                  ///< 8 or 16 bits per channel
-  double full_well_e = 40000;     ///< electrons at saturation
-  double read_noise_e = 4;        ///< read noise, electrons rms
-  double black_level_e = 200;     ///< pedestal added to every pixel, electrons (what a dark frame removes)
-  bool noise = true;              ///< shot (Poisson) and read (Gaussian) noise; off: exact expectation
+  int bits = 16;               ///< 8 or 16 bits per channel
+  double full_well_e = 40000;  ///< electrons at saturation
+  double read_noise_e = 4;     ///< read noise, electrons rms
+  double black_level_e =
+      200;            ///< pedestal added to every pixel, electrons (what a dark frame removes)
+  bool noise = true;  ///< shot (Poisson) and read (Gaussian) noise; off: exact expectation
   /// Electrons per (radiance x exposure time), radiance in the image's units, s: the scene's scale.
   /// 0 picks it so that the brightest pixel at the shortest exposure fills `auto_fill` of the well.
   double electrons_per_radiance_s = 0;

@@ -1,4 +1,5 @@
-// The capture file ("format": "lucent-capture", "version": 1; DESIGN §3): what was photographed and how.
+// The capture file ("format": "lucent-capture", "version": 1; DESIGN §3): what was photographed and
+// how.
 #pragma once
 
 #include <array>
@@ -22,8 +23,8 @@ enum class Response { kLinear, kSrgb, kCalibrate };
 
 /// A stack of brackets or one HDR image (exactly one of the two is set).
 struct ImageSet {
-  std::vector<Bracket> images;                ///< sorted by strictly increasing exposure
-  std::optional<std::filesystem::path> hdr;   ///< linear OpenEXR
+  std::vector<Bracket> images;               ///< sorted by strictly increasing exposure
+  std::optional<std::filesystem::path> hdr;  ///< linear OpenEXR
 };
 
 struct WhiteReference {
@@ -35,14 +36,14 @@ struct Capture {
   static constexpr int kFormatVersion = 1;
 
   ImageSet sample;
-  double pixel_pitch_mm = 0.0;        ///< size of one pixel on the sample, mm (> 0)
-  double incidence_polar_deg = 0.0;   ///< beam angle from the normal, degrees, [0, 90)
-  double incidence_azimuth_deg = 0.0; ///< beam direction in the image plane from +x, degrees
-  double view_deg = 0.0;              ///< camera angle from the normal, degrees, [0, 90)
-  std::optional<double> ior;          ///< the sample's relative index, when known (fit uses it)
+  double pixel_pitch_mm = 0.0;         ///< size of one pixel on the sample, mm (> 0)
+  double incidence_polar_deg = 0.0;    ///< beam angle from the normal, degrees, [0, 90)
+  double incidence_azimuth_deg = 0.0;  ///< beam direction in the image plane from +x, degrees
+  double view_deg = 0.0;               ///< camera angle from the normal, degrees, [0, 90)
+  std::optional<double> ior;           ///< the sample's relative index, when known (fit uses it)
   std::optional<std::array<double, 2>> beam_point_px;  ///< given entry point (x, y) in pixels
   Response response = Response::kLinear;
-  std::optional<std::filesystem::path> dark;           ///< dark frame, same camera settings
+  std::optional<std::filesystem::path> dark;  ///< dark frame, same camera settings
   std::optional<WhiteReference> white_reference;
   std::optional<double> beam_power;  ///< in HDR radiance units x mm^2 sr (when no white reference)
   nlohmann::json provenance;         ///< free-form (the simulator records its settings here)

@@ -8,14 +8,16 @@
 
 namespace lucent::acquire {
 
-/// Linear float RGB, row-major, rows along +y; pixel (x, y) channel c at data[(y * width + x) * 3 + c].
+/// Linear float RGB, row-major, rows along +y; pixel (x, y) channel c at data[(y * width + x) * 3 +
+/// c].
 struct ImageRgb {
   int width = 0;
   int height = 0;
   std::vector<float> data;
 
   ImageRgb() = default;
-  ImageRgb(int w, int h, float fill = 0.0f) : width(w), height(h), data(std::size_t(w) * h * 3, fill) {}
+  ImageRgb(int w, int h, float fill = 0.0f)
+      : width(w), height(h), data(std::size_t(w) * h * 3, fill) {}
   float& at(int x, int y, int c) { return data[(std::size_t(y) * width + x) * 3 + c]; }
   float at(int x, int y, int c) const { return data[(std::size_t(y) * width + x) * 3 + c]; }
   bool empty() const { return data.empty(); }
@@ -29,7 +31,8 @@ struct RawImage {
   std::vector<std::uint16_t> data;
 
   RawImage() = default;
-  RawImage(int w, int h, int max) : width(w), height(h), max_value(max), data(std::size_t(w) * h * 3, 0) {}
+  RawImage(int w, int h, int max)
+      : width(w), height(h), max_value(max), data(std::size_t(w) * h * 3, 0) {}
   std::uint16_t& at(int x, int y, int c) { return data[(std::size_t(y) * width + x) * 3 + c]; }
   std::uint16_t at(int x, int y, int c) const { return data[(std::size_t(y) * width + x) * 3 + c]; }
 };

@@ -1,5 +1,6 @@
-// Reading and writing images: OpenEXR for linear HDR, PNG/TIFF (through OpenCV) for brackets and for
-// what a person looks at. Every writer is atomic; every reader throws lucent::Error naming the file.
+// Reading and writing images: OpenEXR for linear HDR, PNG/TIFF (through OpenCV) for brackets and
+// for what a person looks at. Every writer is atomic; every reader throws lucent::Error naming the
+// file.
 #pragma once
 
 #include <filesystem>

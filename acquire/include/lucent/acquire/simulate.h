@@ -1,5 +1,5 @@
-// `lucent simulate`: a virtual capture rig. Monte Carlo transport (photon_transport.h) gives the exit
-// radiance toward the camera; the camera model (camera.h) turns it into brackets, with a white
+// `lucent simulate`: a virtual capture rig. Monte Carlo transport (photon_transport.h) gives the
+// exit radiance toward the camera; the camera model (camera.h) turns it into brackets, with a white
 // reference and a dark frame, and a capture file that `lucent acquire` reads.
 #pragma once
 
@@ -17,9 +17,9 @@ namespace lucent::acquire {
 
 /// Where the exit radiance comes from.
 enum class RadianceSource {
-  kMonteCarlo,          ///< photon transport (the ground truth)
-  kDipole,              ///< the standard dipole: F_t(in) R_d(r) F_t(out) / pi, for round trips of the fit
-  kDirectionalDipole,   ///< the directional dipole: F_t(in) S_d F_t(out)
+  kMonteCarlo,  ///< photon transport (the ground truth)
+  kDipole,      ///< the standard dipole: F_t(in) R_d(r) F_t(out) / pi, for round trips of the fit
+  kDirectionalDipole,  ///< the directional dipole: F_t(in) S_d F_t(out)
 };
 
 struct SimulateOptions {
@@ -27,21 +27,21 @@ struct SimulateOptions {
   RadianceSource source = RadianceSource::kMonteCarlo;
   PhotonTransportOptions transport;  ///< media are filled from `material`
   CameraOptions camera;
-  bool white_reference = true;       ///< image a Lambertian reference of reflectance 0.99
+  bool white_reference = true;  ///< image a Lambertian reference of reflectance 0.99
   double white_reflectance = 0.99;
   /// Beam radius (1/e^2 half width / 2, i.e. the Gaussian sigma) on the white reference, mm; the
   /// pencil beam of the sample simulation is idealised, a reference spot needs some width to be
   /// imaged. 0 = one pixel pitch.
   double white_spot_sigma_mm = 0;
   bool dark_frame = true;
-  bool profile_only = false;         ///< skip the images (transport without camera)
+  bool profile_only = false;  ///< skip the images (transport without camera)
   std::optional<std::filesystem::path> exitance_csv;  ///< also write the radial table here
 };
 
 struct SimulateSummary {
   PhotonTransportResult transport;
-  double camera_scale = 0;           ///< electrons per (radiance x s)
-  std::vector<std::string> files;    ///< written, relative to the output folder
+  double camera_scale = 0;         ///< electrons per (radiance x s)
+  std::vector<std::string> files;  ///< written, relative to the output folder
 };
 
 /// Runs the rig and writes into `out_dir` (atomically, as a whole folder): capture.json, bracket
@@ -51,14 +51,16 @@ struct SimulateSummary {
 SimulateSummary run_simulation(const SimulateOptions& options, const std::filesystem::path& out_dir,
                                const PhotonTransportProgress& progress = {});
 
-/// The exit radiance per unit power (mm^-2 sr^-1) that a diffusion model predicts on the simulation's
-/// pixel grid, each pixel averaged over 4 x 4 points (the entry point's pixel over 16 x 16).
+/// The exit radiance per unit power (mm^-2 sr^-1) that a diffusion model predicts on the
+/// simulation's pixel grid, each pixel averaged over 4 x 4 points (the entry point's pixel over 16
+/// x 16).
 ImageRgb model_radiance(const materials::Material& material, RadianceSource source,
                         const PhotonTransportOptions& geometry);
 
-/// The radiance image of a Lambertian reference of reflectance rho lit by the same beam (unit power):
-/// rho / pi times a Gaussian spot of width sigma_mm integrated over each pixel (per mm^2), so that
-/// the image integrated over the plane is rho / pi exactly, up to the spot's tail beyond the grid.
+/// The radiance image of a Lambertian reference of reflectance rho lit by the same beam (unit
+/// power): rho / pi times a Gaussian spot of width sigma_mm integrated over each pixel (per mm^2),
+/// so that the image integrated over the plane is rho / pi exactly, up to the spot's tail beyond
+/// the grid.
 ImageRgb white_reference_radiance(int size, double pixel_mm, double rho, double sigma_mm);
 
 }  // namespace lucent::acquire

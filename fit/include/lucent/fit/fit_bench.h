@@ -1,6 +1,6 @@
-// `lucent bench fit`: the fit's speed against its accuracy (DESIGN §8). Each setting (quality, model,
-// derivatives) is run on captures whose truth is known, and its median solve time and parameter
-// errors go to a CSV and a plot of the trade curve.
+// `lucent bench fit`: the fit's speed against its accuracy (DESIGN §8). Each setting (quality,
+// model, derivatives) is run on captures whose truth is known, and its median solve time and
+// parameter errors go to a CSV and a plot of the trade curve.
 #pragma once
 
 #include <filesystem>
@@ -11,8 +11,8 @@ namespace lucent::fit {
 struct FitBenchOptions {
   std::filesystem::path out_dir = "notebooks_data/bench";  ///< fit_tradeoff.csv and .png go here
   std::filesystem::path sample_capture = "notebooks_data/captures/marble_0deg/capture.json";
-  int repeats = 5;     ///< timed fits per setting; the median is reported
-  int size_px = 64;    ///< simulated captures' size
+  int repeats = 5;   ///< timed fits per setting; the median is reported
+  int size_px = 64;  ///< simulated captures' size
 };
 
 /// Runs the sweep; progress lines go to `log`. Returns the number of settings measured.

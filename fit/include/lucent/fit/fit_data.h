@@ -1,5 +1,5 @@
-// What a fit consumes: radial bins (normal incidence) and/or 2D samples (oblique incidence) of pi L / P
-// per mm^2, per channel, with standard errors, and the geometry they were taken in.
+// What a fit consumes: radial bins (normal incidence) and/or 2D samples (oblique incidence) of pi L
+// / P per mm^2, per channel, with standard errors, and the geometry they were taken in.
 #pragma once
 
 #include <array>
@@ -33,27 +33,28 @@ struct Samples2d {
 
 /// One measured profile (one capture).
 struct ProfileData {
-  std::string source;                ///< file it came from
-  bool calibrated = true;            ///< false: values known up to one scale
+  std::string source;      ///< file it came from
+  bool calibrated = true;  ///< false: values known up to one scale
   /// Relative standard error of the calibration (the beam power from the white reference), per
-  /// channel; 0 when exact or unknown. The fit carries it as a per-channel scale with this prior, so
-  /// that the reported uncertainties include it.
+  /// channel; 0 when exact or unknown. The fit carries it as a per-channel scale with this prior,
+  /// so that the reported uncertainties include it.
   std::array<double, 3> calibration_relative_se{};
-  std::optional<double> eta;         ///< relative index when known (CSV: --ior)
+  std::optional<double> eta;  ///< relative index when known (CSV: --ior)
   double incidence_polar_deg = 0;
   double incidence_azimuth_deg = 0;  ///< direction of travel from +x
   double view_deg = 0;
-  /// Exitance per unit power entering (CSV, Monte Carlo tallies) rather than pi L / P from a camera.
+  /// Exitance per unit power entering (CSV, Monte Carlo tallies) rather than pi L / P from a
+  /// camera.
   bool exitance = false;
   RadialBins radial;
   std::optional<Samples2d> samples_2d;
   std::array<bool, 3> channels{true, true, true};  ///< which channels carry data
 };
 
-/// Reads a `lucent-profile` JSON (from lucent acquire) or a CSV with header `r_mm` and value columns
-/// `R` or `R_r,R_g,R_b`, optional `se` / `se_r,se_g,se_b` and `r_inner_mm,r_outer_mm`. CSV values are
-/// per mm^2 per unit power entering; without se columns a 5% relative error is assumed (and said in
-/// the report). Throws lucent::Error with one line naming the file, line or field.
+/// Reads a `lucent-profile` JSON (from lucent acquire) or a CSV with header `r_mm` and value
+/// columns `R` or `R_r,R_g,R_b`, optional `se` / `se_r,se_g,se_b` and `r_inner_mm,r_outer_mm`. CSV
+/// values are per mm^2 per unit power entering; without se columns a 5% relative error is assumed
+/// (and said in the report). Throws lucent::Error with one line naming the file, line or field.
 ProfileData load_profile_data(const std::filesystem::path& path);
 
 }  // namespace lucent::fit

@@ -13,7 +13,8 @@ namespace lucent {
 void write_file_atomically(const std::filesystem::path& path, std::string_view content);
 
 /// For writers that need a file name (image libraries): hands out a temporary path in the target's
-/// folder; commit() renames it over the target; the destructor removes it if commit() was not called.
+/// folder; commit() renames it over the target; the destructor removes it if commit() was not
+/// called.
 class AtomicOutputPath {
  public:
   explicit AtomicOutputPath(std::filesystem::path target);

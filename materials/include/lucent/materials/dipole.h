@@ -11,9 +11,9 @@
 
 namespace lucent::materials {
 
-/// Total diffuse reflectance of the standard dipole over the whole plane, a closed form in the reduced
-/// albedo alpha' and the boundary term A (DESIGN §4):
-/// R_tot = alpha'/2 (1 + e^(-(4/3) A sqrt(3 (1 - alpha')))) e^(-sqrt(3 (1 - alpha'))).
+/// Total diffuse reflectance of the standard dipole over the whole plane, a closed form in the
+/// reduced albedo alpha' and the boundary term A (DESIGN §4): R_tot = alpha'/2 (1 + e^(-(4/3) A
+/// sqrt(3 (1 - alpha')))) e^(-sqrt(3 (1 - alpha'))).
 template <typename T>
 T dipole_total_reflectance(T alpha_prime, T A) {
   using std::exp;
@@ -51,12 +51,12 @@ class StandardDipole {
   std::string to_string() const { return "StandardDipole{" + c_.to_string() + "}"; }
 
  private:
-  // z (1 + sigma_tr d) e^(-sigma_tr d) / d^3 with d = sqrt(r^2 + z^2). In float it is evaluated as one
-  // exponential of a sum of logarithms so that neither e^(-sigma_tr d) nor 1/d^3 under- or overflows
-  // on its own (float reaches 1e-38 in e^(-x) already at x = 87, long before the product is
-  // negligible). In double (and Jets of double) the direct form is safe: e^(-x) underflows only past
-  // x = 745, where z / d^3 <= sigma_t'^2 cannot lift the product above 1e-300; and it is three times
-  // cheaper, which fitting feels.
+  // z (1 + sigma_tr d) e^(-sigma_tr d) / d^3 with d = sqrt(r^2 + z^2). In float it is evaluated as
+  // one exponential of a sum of logarithms so that neither e^(-sigma_tr d) nor 1/d^3 under- or
+  // overflows on its own (float reaches 1e-38 in e^(-x) already at x = 87, long before the product
+  // is negligible). In double (and Jets of double) the direct form is safe: e^(-x) underflows only
+  // past x = 745, where z / d^3 <= sigma_t'^2 cannot lift the product above 1e-300; and it is three
+  // times cheaper, which fitting feels.
   T source_term(T z, T r2) const {
     using std::exp;
     using std::log;

@@ -1,6 +1,6 @@
-// The directional dipole of Frisvad, Hachisuka and Kjeldsen 2014 (seed 003 §3.4.8, Appendix B), in the
-// formulation of the authors' sample code as DESIGN §4.1 spells it out. The thesis writes e^(+sigma_tr r)
-// in eqs. 3.7 and 3.10; the exponent is negative.
+// The directional dipole of Frisvad, Hachisuka and Kjeldsen 2014 (seed 003 §3.4.8, Appendix B), in
+// the formulation of the authors' sample code as DESIGN §4.1 spells it out. The thesis writes
+// e^(+sigma_tr r) in eqs. 3.7 and 3.10; the exponent is negative.
 #pragma once
 
 #include <Eigen/Core>
@@ -37,8 +37,8 @@ class DirectionalDipole {
     // undefined (x_o = x_i, or x along n_i).
     Vec3<T> n_star = n_i;
     // x . n_i*: exactly 0 when n_i* is the modified normal (perpendicular to x by construction);
-    // taken as 0 rather than computed, whose rounding (eps r) would swamp the virtual source's offset
-    // a^2 - 2 a (x . n_i*) at r of thousands of mean free paths.
+    // taken as 0 rather than computed, whose rounding (eps r) would swamp the virtual source's
+    // offset a^2 - 2 a (x . n_i*) at r of thousands of mean free paths.
     T x_n = x.dot(n_i);
     const Vec3<T> nx = n_i.cross(x);
     const T nx2 = nx.squaredNorm();
@@ -48,19 +48,20 @@ class DirectionalDipole {
     }
 
     // Refracted direction of the real source (Snell with relative index 1/eta). Beyond the critical
-    // angle (eta < 1) no light enters and the Fresnel transmittance is 0; the radicand is clamped at 0
-    // so S_d stays finite and continuous there.
+    // angle (eta < 1) no light enters and the Fresnel transmittance is 0; the radicand is clamped
+    // at 0 so S_d stays finite and continuous there.
     const T cos_i = w_i.dot(n_i);
     const T inv_eta = T(1) / c_.eta;
     T radicand = T(1) - (T(1) - cos_i * cos_i) * inv_eta * inv_eta;
     if (radicand < T(0)) radicand = T(0);
-    const Vec3<T> w_r = (-w_i * inv_eta - n_i * (-cos_i * inv_eta + safe_sqrt(radicand))).normalized();
+    const Vec3<T> w_r =
+        (-w_i * inv_eta - n_i * (-cos_i * inv_eta + safe_sqrt(radicand))).normalized();
     const Vec3<T> w_v = w_r - T(2) * w_r.dot(n_star) * n_star;
 
     // Distance to the real source: front-lit points see it through the extrapolated boundary,
-    // back-lit ones at one unreduced mean free path below the surface. Both are kept as offsets from
-    // r^2 (d_r^2 = r^2 + real_offset) so that the real-minus-virtual difference below never subtracts
-    // two nearly equal r^2.
+    // back-lit ones at one unreduced mean free path below the surface. Both are kept as offsets
+    // from r^2 (d_r^2 = r^2 + real_offset) so that the real-minus-virtual difference below never
+    // subtracts two nearly equal r^2.
     const T mu0 = -n_o.dot(w_r);
     T real_offset;
     if (mu0 > T(0)) {
@@ -79,8 +80,9 @@ class DirectionalDipole {
     const T a = T(2) * c_.A_ddipole * c_.d_e;
     const Vec3<T> x_ov = x - a * n_star;
     T virtual_offset = a * a - T(2) * a * x_n;
-    // The virtual source lies outside the medium, 2 A d_e from x_i; only a configuration with x_o off
-    // the surface can come near it. Keep its distance positive there so the result stays finite.
+    // The virtual source lies outside the medium, 2 A d_e from x_i; only a configuration with x_o
+    // off the surface can come near it. Keep its distance positive there so the result stays
+    // finite.
     const T min_d2 = T(1e-12) * c_.d_e * c_.d_e;
     if (r2 + virtual_offset < min_d2) virtual_offset = min_d2 - r2;
 
@@ -103,18 +105,19 @@ class DirectionalDipole {
 
   // S'(x, w_r, d_r) - S'(x_v, w_v, d_v), clamped at 0, where one ray source's profile is
   //   S'(y, w, d) = N / (4 pi^2) e^(-sigma_tr d) / d^3 B(d, y, w),
-  //   B = C_phi (d^2 / D + 3 u (y.w)) - C_E (3 D u (w.n_o) - (u + 3 D (3 u + s^2) (y.w) / d^2) (y.n_o)),
-  //   s = sigma_tr d, u = 1 + s.
-  // Far from the source (r of hundreds of mean free paths at albedo near 1) the two profiles agree to
-  // many digits and their plain difference loses them all, in float above all. So the difference is
-  // taken algebraically: with F = e^(-sigma_tr (d_v - d_r)) (d_r / d_v)^3,
+  //   B = C_phi (d^2 / D + 3 u (y.w)) - C_E (3 D u (w.n_o) - (u + 3 D (3 u + s^2) (y.w) / d^2)
+  //   (y.n_o)), s = sigma_tr d, u = 1 + s.
+  // Far from the source (r of hundreds of mean free paths at albedo near 1) the two profiles agree
+  // to many digits and their plain difference loses them all, in float above all. So the difference
+  // is taken algebraically: with F = e^(-sigma_tr (d_v - d_r)) (d_r / d_v)^3,
   //   S = N / (4 pi^2) e^(-sigma_tr d_r) / d_r^3 [ (B_r - B_v) + B_v (1 - F) ],
   // 1 - F through expm1/log1p, and B_r - B_v term by term from the exact differences of its parts:
   //   d_v^2 - d_r^2 = delta2 (no r^2 in it), (y.w)_r - (y.w)_v = b (x.n*) - a (w_r.n*),
   //   (w.n_o)_r - (w.n_o)_v = b (n*.n_o), (y.n_o)_r - (y.n_o)_v = a (n*.n_o),
-  // where x_v = x - a n*, w_v = w_r - b n*. Algebraically identical to the authors' form (the golden
-  // test holds the two together to 1e-10). Where the virtual source is much the weaker (F < 1/2, as at
-  // low albedo, where it sits far above the surface) the plain B_r - B_v F is the better form.
+  // where x_v = x - a n*, w_v = w_r - b n*. Algebraically identical to the authors' form (the
+  // golden test holds the two together to 1e-10). Where the virtual source is much the weaker (F <
+  // 1/2, as at low albedo, where it sits far above the surface) the plain B_r - B_v F is the better
+  // form.
   T difference_of_sources(const Vec3<T>& x, const Vec3<T>& w_r, T d_r2, const Vec3<T>& x_ov,
                           const Vec3<T>& w_v, T d_v2, T delta2, T a, T b, T x_n,
                           const Vec3<T>& n_star, const Vec3<T>& n_o) const {
@@ -136,8 +139,8 @@ class DirectionalDipole {
     const T q_v = T(1) / d_v2;
     const T H_v = T(3) * u_v + s_v * s_v;
     const T G_v = u_v + T(3) * D * H_v * q_v * yw_v;
-    const T B_v = c_.C_phi * (d_v2 / D + T(3) * u_v * yw_v) -
-                  c_.C_E * (T(3) * D * u_v * wn_v - G_v * yn_v);
+    const T B_v =
+        c_.C_phi * (d_v2 / D + T(3) * u_v * yw_v) - c_.C_E * (T(3) * D * u_v * wn_v - G_v * yn_v);
 
     const T s_r = sigma * d_r;
     const T u_r = T(1) + s_r;
@@ -152,16 +155,16 @@ class DirectionalDipole {
       // well conditioned, and the term-by-term one would subtract large parts of B_v instead.
       const T yw_r = x.dot(w_r), wn_r = w_r.dot(n_o), yn_r = x.dot(n_o);
       const T G_r = u_r + T(3) * D * H_r * q_r * yw_r;
-      const T B_r = c_.C_phi * (d_r2 / D + T(3) * u_r * yw_r) -
-                    c_.C_E * (T(3) * D * u_r * wn_r - G_r * yn_r);
+      const T B_r =
+          c_.C_phi * (d_r2 / D + T(3) * u_r * yw_r) - c_.C_E * (T(3) * D * u_r * wn_r - G_r * yn_r);
       bracket = B_r - B_v * exp(log_F);
     } else {
-      const T d_u = sigma * dd;                                // u_r - u_v
-      const T d_yw = b * x_n - a * w_r.dot(n_star);  // (y.w)_r - (y.w)_v
-      const T d_wn = b * n_star.dot(n_o);                      // (w.n_o)_r - (w.n_o)_v
-      const T d_yn = a * n_star.dot(n_o);                      // (y.n_o)_r - (y.n_o)_v
-      const T d_q = delta2 * q_r * q_v;                        // 1/d_r^2 - 1/d_v^2
-      const T d_H = T(3) * d_u - sigma * sigma * delta2;       // H_r - H_v
+      const T d_u = sigma * dd;                           // u_r - u_v
+      const T d_yw = b * x_n - a * w_r.dot(n_star);       // (y.w)_r - (y.w)_v
+      const T d_wn = b * n_star.dot(n_o);                 // (w.n_o)_r - (w.n_o)_v
+      const T d_yn = a * n_star.dot(n_o);                 // (y.n_o)_r - (y.n_o)_v
+      const T d_q = delta2 * q_r * q_v;                   // 1/d_r^2 - 1/d_v^2
+      const T d_H = T(3) * d_u - sigma * sigma * delta2;  // H_r - H_v
       const T d_G = d_u + T(3) * D * (H_r * q_r * d_yw + H_r * d_q * yw_v + d_H * q_v * yw_v);
       const T G_r = G_v + d_G;
       const T d_B = c_.C_phi * (-delta2 / D + T(3) * (u_r * d_yw + d_u * yw_v)) -

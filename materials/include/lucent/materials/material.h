@@ -20,14 +20,14 @@ struct Material {
   static constexpr int kFormatVersion = 1;
 
   std::string name;
-  double ior = 1.3;                 ///< relative index, n_sample / n_outside
-  Rgb sigma_a{};                    ///< absorption, mm^-1
-  Rgb sigma_s_reduced{};            ///< reduced scattering sigma_s (1 - g), mm^-1
-  std::optional<Rgb> sigma_s;       ///< unreduced scattering, mm^-1 (with g)
-  std::optional<Rgb> g;             ///< Henyey-Greenstein mean cosine
-  std::string model;                ///< the model it was fitted with ("dipole", "ddipole"), or ""
-  nlohmann::json uncertainty;       ///< standard deviations and correlations; null when not fitted
-  nlohmann::json provenance;        ///< source table or capture, fit statistics, tool version
+  double ior = 1.3;            ///< relative index, n_sample / n_outside
+  Rgb sigma_a{};               ///< absorption, mm^-1
+  Rgb sigma_s_reduced{};       ///< reduced scattering sigma_s (1 - g), mm^-1
+  std::optional<Rgb> sigma_s;  ///< unreduced scattering, mm^-1 (with g)
+  std::optional<Rgb> g;        ///< Henyey-Greenstein mean cosine
+  std::string model;           ///< the model it was fitted with ("dipole", "ddipole"), or ""
+  nlohmann::json uncertainty;  ///< standard deviations and correlations; null when not fitted
+  nlohmann::json provenance;   ///< source table or capture, fit statistics, tool version
 
   /// One channel (0 = R, 1 = G, 2 = B) as a Medium; isotropic when only sigma_s' is known.
   Medium<double> medium(int channel) const;
@@ -36,7 +36,8 @@ struct Material {
 };
 
 /// Parses a material document. `source` names the file in error messages.
-/// Throws lucent::Error "<source>: field '<name>': <what was expected>" on anything it does not accept.
+/// Throws lucent::Error "<source>: field '<name>': <what was expected>" on anything it does not
+/// accept.
 Material material_from_json(const nlohmann::json& doc, const std::string& source);
 
 /// The document written to disk: format, version, the fields above, and "derived" quantities per

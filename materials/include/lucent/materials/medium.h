@@ -1,6 +1,6 @@
 // Optical properties of one colour channel and the coefficients diffusion theory derives from them.
-// Everything is templated on the scalar type so the same code runs in double (reference), float (the
-// shaders' twin) and ceres::Jet (fitting). All lengths in mm, all coefficients in mm^-1.
+// Everything is templated on the scalar type so the same code runs in double (reference), float
+// (the shaders' twin) and ceres::Jet (fitting). All lengths in mm, all coefficients in mm^-1.
 #pragma once
 
 #include <cmath>
@@ -60,15 +60,25 @@ DiffusionCoefficients<T> derive_coefficients(const Medium<T>& m) {
   using std::sqrt;
   if constexpr (std::is_same_v<T, float>) {
     // The Fresnel-moment fits sum terms of size 1e3 to results of size 0.1: in float they keep only
-    // four digits. Like the shaders, which get these constants from the CPU, float models derive them
-    // in double and round once.
-    const auto d = derive_coefficients(
-        Medium<double>{m.sigma_a, m.sigma_s, m.g, m.eta});
-    return DiffusionCoefficients<float>{
-        float(d.eta),     float(d.sigma_s_reduced), float(d.sigma_t_reduced), float(d.sigma_t),
-        float(d.alpha_prime), float(d.D),           float(d.sigma_tr),        float(d.z_r),
-        float(d.F_dr),    float(d.A_dipole),        float(d.z_v),             float(d.d_e),
-        float(d.C_phi),   float(d.C_E),             float(d.A_ddipole),       float(d.normalisation)};
+    // four digits. Like the shaders, which get these constants from the CPU, float models derive
+    // them in double and round once.
+    const auto d = derive_coefficients(Medium<double>{m.sigma_a, m.sigma_s, m.g, m.eta});
+    return DiffusionCoefficients<float>{float(d.eta),
+                                        float(d.sigma_s_reduced),
+                                        float(d.sigma_t_reduced),
+                                        float(d.sigma_t),
+                                        float(d.alpha_prime),
+                                        float(d.D),
+                                        float(d.sigma_tr),
+                                        float(d.z_r),
+                                        float(d.F_dr),
+                                        float(d.A_dipole),
+                                        float(d.z_v),
+                                        float(d.d_e),
+                                        float(d.C_phi),
+                                        float(d.C_E),
+                                        float(d.A_ddipole),
+                                        float(d.normalisation)};
   }
   DiffusionCoefficients<T> c;
   c.eta = m.eta;
@@ -111,8 +121,8 @@ template <typename T>
 std::string Medium<T>::to_string() const {
   std::ostringstream s;
   s.precision(6);
-  s << "Medium{sigma_a=" << detail::scalar_value(sigma_a) << "/mm, sigma_s="
-    << detail::scalar_value(sigma_s) << "/mm, g=" << detail::scalar_value(g)
+  s << "Medium{sigma_a=" << detail::scalar_value(sigma_a)
+    << "/mm, sigma_s=" << detail::scalar_value(sigma_s) << "/mm, g=" << detail::scalar_value(g)
     << ", eta=" << detail::scalar_value(eta) << "}";
   return s.str();
 }
@@ -123,8 +133,8 @@ std::string DiffusionCoefficients<T>::to_string() const {
   std::ostringstream s;
   s.precision(6);
   s << "DiffusionCoefficients{eta=" << scalar_value(eta)
-    << ", sigma_s'=" << scalar_value(sigma_s_reduced) << "/mm, sigma_t'="
-    << scalar_value(sigma_t_reduced) << "/mm, sigma_t=" << scalar_value(sigma_t)
+    << ", sigma_s'=" << scalar_value(sigma_s_reduced)
+    << "/mm, sigma_t'=" << scalar_value(sigma_t_reduced) << "/mm, sigma_t=" << scalar_value(sigma_t)
     << "/mm, alpha'=" << scalar_value(alpha_prime) << ", D=" << scalar_value(D)
     << "mm, sigma_tr=" << scalar_value(sigma_tr) << "/mm, z_r=" << scalar_value(z_r)
     << "mm, z_v=" << scalar_value(z_v) << "mm, F_dr=" << scalar_value(F_dr)

@@ -14,7 +14,8 @@ namespace lucent::materials {
 enum class DiffusionModel { kDipole, kDirectionalDipole };
 
 /// "dipole" or "ddipole"; anything else throws lucent::Error naming the option.
-DiffusionModel parse_diffusion_model(const std::string& name, const std::string& option = "--model");
+DiffusionModel parse_diffusion_model(const std::string& name,
+                                     const std::string& option = "--model");
 std::string to_string(DiffusionModel model);
 
 /// "0.1,0.5,1,2" -> radii in mm; each must be finite and >= 0.
@@ -29,10 +30,11 @@ struct RadialProfileOptions {
   bool total = false;        ///< append the total diffuse reflectance per channel
 };
 
-/// CSV `r_mm,Rd_r,Rd_g,Rd_b`: radially symmetric diffuse reflectance per mm^2 for unit incident flux.
-/// dipole: R_d(r). ddipole: pi S_d at normal incidence on a plane (light along the normal, x_o at
-/// distance r), the quantity the directional dipole puts in R_d's place. With `total`, a last row
-/// `total,...`: the closed form for the dipole, numerical quadrature over the plane for the ddipole.
+/// CSV `r_mm,Rd_r,Rd_g,Rd_b`: radially symmetric diffuse reflectance per mm^2 for unit incident
+/// flux. dipole: R_d(r). ddipole: pi S_d at normal incidence on a plane (light along the normal,
+/// x_o at distance r), the quantity the directional dipole puts in R_d's place. With `total`, a
+/// last row `total,...`: the closed form for the dipole, numerical quadrature over the plane for
+/// the ddipole.
 std::string radial_profile_csv(const Material& material, const RadialProfileOptions& options);
 
 /// One BSSRDF configuration: positions in mm, unit normals and light direction.

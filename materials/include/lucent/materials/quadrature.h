@@ -9,15 +9,15 @@
 
 namespace lucent::materials {
 
-/// Adaptive 15-point Gauss-Kronrod quadrature of f over [a, b] to the requested absolute or relative
-/// tolerance (whichever is reached first), at most `max_intervals` subdivisions.
+/// Adaptive 15-point Gauss-Kronrod quadrature of f over [a, b] to the requested absolute or
+/// relative tolerance (whichever is reached first), at most `max_intervals` subdivisions.
 double integrate(const std::function<double(double)>& f, double a, double b, double rel_tol = 1e-10,
                  double abs_tol = 0.0, int max_intervals = 2000);
 
 /// Integral of a radially symmetric function over the whole plane: 2 pi int_0^inf r f(r) dr.
 /// `length_scale_mm` sets where the panels start (use a mean free path): the range is cut into
-/// geometrically growing panels, each integrated adaptively, until a panel adds less than rel_tol of
-/// the running total for several panels in a row.
+/// geometrically growing panels, each integrated adaptively, until a panel adds less than rel_tol
+/// of the running total for several panels in a row.
 double integrate_over_plane(const std::function<double(double)>& f, double length_scale_mm,
                             double rel_tol = 1e-10);
 
