@@ -340,7 +340,7 @@ Observations observations_for(const ProfileData& d, int c, double exclude_mm, bo
   return o;
 }
 
-StartValues start_values(const ProfileData& d, int c, double eta, bool relative) {
+StartValues start_values(const ProfileData& d, int c, double eta, bool relative, bool search) {
   StartValues sv;
   const double sigma_tr = far_field_sigma_tr(d.radial, c);
   double alpha = 0.99;
@@ -390,7 +390,7 @@ StartValues start_values(const ProfileData& d, int c, double eta, bool relative)
   // (alpha', sigma_t') on a dozen bins and keep whichever start matches the data better: a few
   // thousand dipole evaluations, cheap next to the solve, and the solve starts in the right valley.
   std::vector<std::size_t> use;
-  for (std::size_t i = 0; i < d.radial.size(); ++i) {
+  for (std::size_t i = 0; search && i < d.radial.size(); ++i) {
     if (d.radial.r_mm[i] > 0 && d.radial.value[c][i] > 2 * d.radial.standard_error[c][i])
       use.push_back(i);
   }
@@ -399,22 +399,27 @@ StartValues start_values(const ProfileData& d, int c, double eta, bool relative)
     for (int k = 0; k < 12; ++k)
       pick.push_back(use[std::min(use.size() - 1, k * (use.size() - 1) / 11)]);
     const double r_min = d.radial.r_mm[pick.front()], r_max = d.radial.r_mm[pick.back()];
+    std::array<double, 12> log_data{}, w{};
+    for (std::size_t k = 0; k < pick.size(); ++k) {
+      const std::size_t i = pick[k];
+      log_data[k] = std::log(d.radial.value[c][i]);
+      const double inv_rel = d.radial.value[c][i] / d.radial.standard_error[c][i];
+      w[k] = inv_rel * inv_rel;
+    }
+    const double log_fresnel = std::log(fresnel);
     const auto cost = [&](double sa, double ss, double* log_scale) {
-      const materials::StandardDipole<double> dipole(
-          materials::Medium<double>::from_reduced(sa, ss, eta));
+      const materials::StandardDipole<double> dipole(materials::Medium<double>::from_reduced(sa, ss, eta));
       double sum = 0, sum2 = 0, wsum = 0;
-      std::array<double, 12> diff{}, w{};
+      std::array<double, 12> diff{};
       for (std::size_t k = 0; k < pick.size(); ++k) {
-        const std::size_t i = pick[k];
-        const double m = fresnel * dipole.R_d(d.radial.r_mm[i]);
+        const double m = dipole.R_d(d.radial.r_mm[pick[k]]);
         if (!(m > 0)) return double(INFINITY);
-        diff[k] = std::log(d.radial.value[c][i]) - std::log(m);
-        w[k] = std::pow(d.radial.value[c][i] / d.radial.standard_error[c][i], 2);
+        diff[k] = log_data[k] - log_fresnel - std::log(m);
         sum += w[k] * diff[k];
         wsum += w[k];
       }
       const double shift = relative ? sum / wsum : 0.0;
-      for (std::size_t k = 0; k < pick.size(); ++k) sum2 += w[k] * std::pow(diff[k] - shift, 2);
+      for (std::size_t k = 0; k < pick.size(); ++k) sum2 += w[k] * (diff[k] - shift) * (diff[k] - shift);
       if (log_scale) *log_scale = shift;
       return sum2;
     };
@@ -721,7 +726,14 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
   std::array<StartValues, 3> given;
   for (int c = 0; c < 3; ++c) {
     if (!channels[c]) continue;
-    start[c] = start_values(data.front(), c, eta0, relative);
+    start[c] = start_values(data.front(), c, eta0, relative, false);
+    // A transport mean free path beyond a quarter of the data's reach means the far-field estimate
+    // failed (no exponential tail in the image): search instead, since the exclusion radius comes
+    // from it too.
+    const double reach = data.front().radial.size() ? data.front().radial.r_mm.back() : 0.0;
+    if (1.0 / (start[c].sigma_a + start[c].sigma_s_reduced) > 0.25 * reach) {
+      start[c] = start_values(data.front(), c, eta0, relative, true);
+    }
     given[c] = start[c];
     if (options.start) {
       given[c].sigma_a = (*options.start)[c][0];
@@ -755,6 +767,20 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
       ModelFit other = solve(data, options, m, eta0, relative, result.exclude_radius_mm, given,
                              channels, &below_noise);
       if (other.chi2 <= best.chi2) best = other;
+    }
+    bool poor = !best.converged;
+    for (int c = 0; c < 3; ++c) poor = poor || (channels[c] && best.channels[c].residual_rms > 3.0);
+    if (poor) {
+      // The far-field start can miss the valley (a profile that ends within a diffusion length has
+      // no exponential tail and leaves light outside the image); search a grid of (alpha', sigma_t')
+      // for a second start and keep the better solution.
+      std::array<StartValues, 3> searched = start;
+      for (int c = 0; c < 3; ++c) {
+        if (channels[c]) searched[c] = start_values(data.front(), c, eta0, relative, true);
+      }
+      ModelFit other = solve(data, options, m, eta0, relative, result.exclude_radius_mm, searched,
+                             channels, &below_noise);
+      if (other.chi2 < best.chi2) best = other;
     }
     result.candidates.push_back(best);
   }
