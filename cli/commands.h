@@ -11,5 +11,6 @@ void register_simulate_command(CLI::App& app);
 void register_acquire_command(CLI::App& app);
 void register_fit_command(CLI::App& app);
 void register_bench_command(CLI::App& app);
+void register_render_command(CLI::App& app);
 
 }  // namespace lucent::cli

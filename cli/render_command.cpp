@@ -63,7 +63,8 @@ std::vector<double> parse_numbers(const std::string& text, const std::string& op
     if (end == std::string::npos) break;
     start = end + 1;
   }
-  if (values.size() != count) throw Error(option + ": expected " + expected + ", got '" + text + "'");
+  if (values.size() != count)
+    throw Error(option + ": expected " + expected + ", got '" + text + "'");
   return values;
 }
 
@@ -125,8 +126,9 @@ void run_render(RenderArguments& args) {
   std::optional<EnvironmentArgument> env;
   if (!args.env.empty()) env = parse_environment_argument(args.env);
   if (lights.empty() && !env) {
-    throw Error("no light: give --light directional:DX,DY,DZ:R,G,B, --light point:X,Y,Z:R,G,B or "
-                "--env FILE[:L]");
+    throw Error(
+        "no light: give --light directional:DX,DY,DZ:R,G,B, --light point:X,Y,Z:R,G,B or "
+        "--env FILE[:L]");
   }
 
   Scene scene;
@@ -162,8 +164,9 @@ void run_render(RenderArguments& args) {
 #if LUCENT_RENDER_HAS_RADIANCE_MAPS
     image = render_radiance_maps(scene, args.settings, &stats);
 #else
-    throw Error("--technique maps: the radiance-map technique is not built yet; use --technique "
-                "reference");
+    throw Error(
+        "--technique maps: the radiance-map technique is not built yet; use --technique "
+        "reference");
 #endif
   }
 
@@ -223,8 +226,7 @@ void register_render_command(CLI::App& app) {
                   "distance from the centre in bounding-sphere radii; field of view 35 degrees")
       ->capture_default_str();
   cmd->add_option("--size", args->size, "image size WxH in pixels")->capture_default_str();
-  cmd->add_option("--object-size-mm", args->object_size_mm,
-                  "bounding-box diagonal of the mesh, mm")
+  cmd->add_option("--object-size-mm", args->object_size_mm, "bounding-box diagonal of the mesh, mm")
       ->capture_default_str();
   cmd->add_option("--exposure", args->settings.exposure,
                   "linear scale before the tone curve (PNG only; EXR stays linear)")
@@ -257,7 +259,8 @@ void register_render_command(CLI::App& app) {
   cmd->add_option("--radiance-map", args->settings.radiance_map_size,
                   "maps: W_s, radiance-map size in texels")
       ->capture_default_str();
-  cmd->add_option("--light-map", args->settings.light_map_size, "maps: W_l, light-map size in texels")
+  cmd->add_option("--light-map", args->settings.light_map_size,
+                  "maps: W_l, light-map size in texels")
       ->capture_default_str();
   cmd->add_option("-o,--output", args->output,
                   "output image: .png (tone-mapped sRGB) or .exr (linear); written atomically")

@@ -1,5 +1,5 @@
-// End-to-end tests of `lucent render` (cli/render_command.cpp): tiny reference renders to PNG and EXR,
-// and every kind of bad input failing with one line on stderr and no output file.
+// End-to-end tests of `lucent render` (cli/render_command.cpp): tiny reference renders to PNG and
+// EXR, and every kind of bad input failing with one line on stderr and no output file.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -34,13 +34,17 @@ std::string read_prefix(const fs::path& path, std::size_t n) {
   return s;
 }
 
-int lines(const std::string& text) { return int(std::count(text.begin(), text.end(), '\n')); }
+int lines(const std::string& text) {
+  return int(std::count(text.begin(), text.end(), '\n'));
+}
 
 TEST(RenderCommand, ReferenceToPngWithStats) {
   const auto dir = scratch_dir("render-png");
   const fs::path out = dir / "sphere.png", stats = dir / "stats.json";
-  const auto r = run_lucent(kTiny + "--material marble --mesh sphere --light directional:1,1,1:2,2,2 "
-                                    "-o \"" + out.string() + "\" --stats \"" + stats.string() + "\"",
+  const auto r = run_lucent(kTiny +
+                                "--material marble --mesh sphere --light directional:1,1,1:2,2,2 "
+                                "-o \"" +
+                                out.string() + "\" --stats \"" + stats.string() + "\"",
                             "png");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.err.empty()) << r.err;
@@ -60,8 +64,9 @@ TEST(RenderCommand, ReferenceToPngWithStats) {
 TEST(RenderCommand, ReferenceToExrWithPointLightAndDipole) {
   const auto dir = scratch_dir("render-exr");
   const fs::path out = dir / "sphere.exr";
-  const auto r = run_lucent(kTiny + "--material ketchup --model dipole "
-                                    "--light point:0,80,80:20000,20000,20000 -o \"" +
+  const auto r = run_lucent(kTiny +
+                                "--material ketchup --model dipole "
+                                "--light point:0,80,80:20000,20000,20000 -o \"" +
                                 out.string() + "\"",
                             "exr");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -78,9 +83,9 @@ TEST(RenderCommand, EnvironmentLightsTheObject) {
     f << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4 +X 8\n";
     for (int p = 0; p < 32; ++p) f << char(128) << char(128) << char(128) << char(129);
   }
-  const auto r = run_lucent(kTiny + "--material marble --env \"" + env.string() + ":4\" -o \"" +
-                                out.string() + "\"",
-                            "env");
+  const auto r = run_lucent(
+      kTiny + "--material marble --env \"" + env.string() + ":4\" -o \"" + out.string() + "\"",
+      "env");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(fs::exists(out));
   fs::remove_all(dir);
@@ -96,7 +101,8 @@ TEST(RenderCommand, NonManifoldMeshWarnsAndRenders) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("warning: "), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("4 non-manifold edges; rendering what is there"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("4 non-manifold edges; rendering what is there"), std::string::npos)
+      << r.err;
   EXPECT_TRUE(fs::exists(out));
   fs::remove_all(dir);
 }
@@ -104,8 +110,8 @@ TEST(RenderCommand, NonManifoldMeshWarnsAndRenders) {
 // Each bad input: non-zero exit, exactly one line on stderr naming the problem, no output file.
 struct BadCase {
   const char* name;
-  std::string args;       // after kTiny, before -o
-  const char* mentions;   // a word the error line must contain
+  std::string args;      // after kTiny, before -o
+  const char* mentions;  // a word the error line must contain
 };
 
 class RenderCommandBadInput : public ::testing::TestWithParam<BadCase> {};
@@ -136,15 +142,17 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         BadCase{"unknown_mesh", "--material marble --mesh teapot --light directional:0,0,1:1,1,1",
                 "teapot"},
-        BadCase{"empty_mesh", "--material marble --mesh $DIR/points.ply "
-                              "--light directional:0,0,1:1,1,1",
+        BadCase{"empty_mesh",
+                "--material marble --mesh $DIR/points.ply "
+                "--light directional:0,0,1:1,1,1",
                 "no triangles"},
         BadCase{"missing_material", "--material unobtainium --light directional:0,0,1:1,1,1",
                 "unobtainium"},
         BadCase{"no_light", "--material marble", "no light"},
         BadCase{"zero_size", "--material marble --light directional:0,0,1:1,1,1 --size 0x0",
                 "--size"},
-        BadCase{"bad_size", "--material marble --light directional:0,0,1:1,1,1 --size 64", "--size"},
+        BadCase{"bad_size", "--material marble --light directional:0,0,1:1,1,1 --size 64",
+                "--size"},
         BadCase{"env_not_an_image", "--material marble --env $DIR/notes.exr", "notes.exr"},
         BadCase{"bad_light", "--material marble --light directional:0,0,0:1,1,1", "--light"},
         BadCase{"bad_model", "--material marble --light directional:0,0,1:1,1,1 --model tripole",
@@ -154,17 +162,18 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"bad_technique",
                 "--material marble --light directional:0,0,1:1,1,1 --technique raytrace",
                 "--technique"},
-        BadCase{"bad_maps_setting",
-                "--material marble --light directional:0,0,1:1,1,1 --samples 2000 --disc-points 1000",
-                "--samples"}),
+        BadCase{
+            "bad_maps_setting",
+            "--material marble --light directional:0,0,1:1,1,1 --samples 2000 --disc-points 1000",
+            "--samples"}),
     [](const ::testing::TestParamInfo<BadCase>& info) { return std::string(info.param.name); });
 
 TEST(RenderCommand, UnsupportedOutputFormatFails) {
   const auto dir = scratch_dir("render-tif");
   const fs::path out = dir / "out.tif";
-  const auto r = run_lucent(kTiny + "--material marble --light directional:0,0,1:1,1,1 -o \"" +
-                                out.string() + "\"",
-                            "tif");
+  const auto r = run_lucent(
+      kTiny + "--material marble --light directional:0,0,1:1,1,1 -o \"" + out.string() + "\"",
+      "tif");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_EQ(lines(r.err), 1) << r.err;
   EXPECT_FALSE(fs::exists(out));

@@ -20,7 +20,8 @@ namespace fs = std::filesystem;
 constexpr double kPi = std::numbers::pi;
 
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("lucent-env-test-" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("lucent-env-test-" + std::to_string(::getpid()));
   fs::create_directories(dir);
   return dir / name;
 }
@@ -85,7 +86,8 @@ TEST(EnvironmentLights, EstimateIrradiance) {
   // Under a constant sky of radiance 1, any surface gets irradiance pi: sum_k L_k max(0, n . w_k)
   // with stratified directions is close even for 64 lights.
   const auto lights = environment_lights(constant_map(128, 64, 1.0f), 256, 5);
-  for (const Vec3f& n : {Vec3f(0, 1, 0), Vec3f(1, 0, 0), Vec3f(0, 0, -1), Vec3f(1, 1, 1).normalized()}) {
+  for (const Vec3f& n :
+       {Vec3f(0, 1, 0), Vec3f(1, 0, 0), Vec3f(0, 0, -1), Vec3f(1, 1, 1).normalized()}) {
     double E = 0;
     for (const Light& l : lights) E += l.radiance[0] * std::max(0.0f, n.dot(l.direction));
     EXPECT_NEAR(E, kPi, 0.05 * kPi) << n.transpose();

@@ -1,7 +1,7 @@
-// The GLSL BSSRDFs (render/shaders/bssrdf_ddipole.glsl, bssrdf_dipole.glsl, fresnel.glsl) against the
-// C++ models in double (materials/include/lucent/materials/directional_dipole.h, dipole.h,
-// fresnel.h): evaluated in a compute shader on 20,000 random configurations over realistic media and
-// geometry, front- and back-lit. Skipped when no headless OpenGL 4.5 context can be created.
+// The GLSL BSSRDFs (render/shaders/bssrdf_ddipole.glsl, bssrdf_dipole.glsl, fresnel.glsl) against
+// the C++ models in double (materials/include/lucent/materials/directional_dipole.h, dipole.h,
+// fresnel.h): evaluated in a compute shader on 20,000 random configurations over realistic media
+// and geometry, front- and back-lit. Skipped when no headless OpenGL 4.5 context can be created.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -59,7 +59,8 @@ void main() {
 
 // double(float(v)), kept: g++ 12.2 at -O2 (tree SLP vectorisation) drops the double -> float ->
 // double round trip when it is applied to the components of Eigen vectors, silently leaving the
-// "float-representable" inputs unrounded (reproduced in isolation; -fno-tree-vectorize restores it).
+// "float-representable" inputs unrounded (reproduced in isolation; -fno-tree-vectorize restores
+// it).
 double to_float(double v) {
   volatile float f = static_cast<float>(v);
   return f;
@@ -73,8 +74,9 @@ struct Config {
 };
 
 // Realistic media (sigma_a 1e-4..2 /mm, sigma_s' 0.05..10 /mm, g 0..0.9, eta 1..1.6 and, one case
-// in ten, 0.8..1) and geometry at object scale (positions within 50 mm of the origin, r 1e-3..100 mm):
-// planes, spheres seen from the lit side and from behind, slabs lit from the back, random normals.
+// in ten, 0.8..1) and geometry at object scale (positions within 50 mm of the origin, r 1e-3..100
+// mm): planes, spheres seen from the lit side and from behind, slabs lit from the back, random
+// normals.
 class ConfigGenerator {
  public:
   explicit ConfigGenerator(std::uint64_t seed) : rng_(seed) {}
@@ -103,7 +105,8 @@ class ConfigGenerator {
         const double radius = std::pow(10.0, uniform(0.5, 2.0));
         const Vec3d centre = c.x_i - radius * random_unit();
         c.n_i = (c.x_i - centre).normalized();
-        const double angle = (i % 5 == 1) ? std::min(r / radius, M_PI / 2) : uniform(M_PI / 2, M_PI);
+        const double angle =
+            (i % 5 == 1) ? std::min(r / radius, M_PI / 2) : uniform(M_PI / 2, M_PI);
         const Vec3d axis = c.n_i.cross(random_unit()).normalized();
         c.n_o = Eigen::AngleAxisd(angle, axis) * c.n_i;
         c.x_o = centre + radius * c.n_o;
@@ -165,23 +168,26 @@ double ddipole_float(const Config& c) {
                                                     c.n_o.cast<float>());
 }
 
-// The two sources of S_d = S'_real - S'_virtual in the plain form of the authors' sample code (DESIGN
-// §4.1), in long double: only to measure how much the difference cancels. cancellation = (|S'_real|
-// + |S'_virtual|) / |S_d| multiplies every rounding made before the subtraction; no float formulation
-// of S_d can do better than about eps times it near the zero crossing (where it is clamped).
+// The two sources of S_d = S'_real - S'_virtual in the plain form of the authors' sample code
+// (DESIGN §4.1), in long double: only to measure how much the difference cancels. cancellation =
+// (|S'_real|
+// + |S'_virtual|) / |S_d| multiplies every rounding made before the subtraction; no float
+// formulation of S_d can do better than about eps times it near the zero crossing (where it is
+// clamped).
 double cancellation(const Config& c) {
   using R = long double;
   using V = Eigen::Matrix<R, 3, 1>;
   const auto k = materials::derive_coefficients(c.medium);
-  const V x_i = c.x_i.cast<R>(), n_i = c.n_i.cast<R>(), w_i = c.w_i.cast<R>(), x_o = c.x_o.cast<R>(),
-          n_o = c.n_o.cast<R>();
+  const V x_i = c.x_i.cast<R>(), n_i = c.n_i.cast<R>(), w_i = c.w_i.cast<R>(),
+          x_o = c.x_o.cast<R>(), n_o = c.n_o.cast<R>();
   const R D = k.D, sigma_tr = k.sigma_tr, d_e = k.d_e, eta = k.eta;
   const auto profile = [&](const V& x, const V& w, R r) {
     const R s = sigma_tr * r;
     return R(k.normalisation) / (4 * M_PI * M_PI) * std::exp(-s) / (r * r * r) *
            (R(k.C_phi) * (r * r / D + 3 * (1 + s) * x.dot(w)) -
-            R(k.C_E) * (3 * D * (1 + s) * w.dot(n_o) -
-                        ((1 + s) + 3 * D * (3 * (1 + s) + s * s) / (r * r) * x.dot(w)) * x.dot(n_o)));
+            R(k.C_E) *
+                (3 * D * (1 + s) * w.dot(n_o) -
+                 ((1 + s) + 3 * D * (3 * (1 + s) + s * s) / (r * r) * x.dot(w)) * x.dot(n_o)));
   };
   const V x = x_o - x_i;
   const R r = x.norm();
@@ -195,7 +201,8 @@ double cancellation(const Config& c) {
   const R mu0 = -n_o.dot(w_r);
   R d_r2;
   if (mu0 > 0) {
-    const R cos_beta = -std::sqrt(std::max(R(0), (r * r - x.dot(w_r) * x.dot(w_r)) / (r * r + d_e * d_e)));
+    const R cos_beta =
+        -std::sqrt(std::max(R(0), (r * r - x.dot(w_r) * x.dot(w_r)) / (r * r + d_e * d_e)));
     d_r2 = r * r + D * mu0 * (D * mu0 - 2 * d_e * cos_beta);
   } else {
     d_r2 = r * r + 1 / (9 * R(k.sigma_t) * R(k.sigma_t));
@@ -214,7 +221,9 @@ double float_rounding_sensitivity(const Config& c, double S, std::mt19937_64& rn
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const double eps = 4.0 * std::ldexp(1.0, -24);
   const auto nudge = [&](double v) { return v * (1.0 + eps * u(rng)); };
-  const auto nudge3 = [&](const Vec3d& v) { return Vec3d(nudge(v.x()), nudge(v.y()), nudge(v.z())); };
+  const auto nudge3 = [&](const Vec3d& v) {
+    return Vec3d(nudge(v.x()), nudge(v.y()), nudge(v.z()));
+  };
   double worst = 0.0;
   for (int k = 0; k < 8; ++k) {
     Config n = c;
@@ -320,15 +329,16 @@ TEST_F(GlslTwinTest, DirectionalDipoleMatchesDoubleModel) {
     } else if (++bad <= 5) {
       ADD_FAILURE() << c.kind << " " << c.medium.to_string() << " r=" << c.r << " S=" << S
                     << " S_glsl=" << S_glsl << " relative error " << e
-                    << " (C++ float: " << std::abs(ddipole_float(c) - S) / S
-                    << ", cancellation " << cancellation(c) << ")";
+                    << " (C++ float: " << std::abs(ddipole_float(c) - S) / S << ", cancellation "
+                    << cancellation(c) << ")";
     }
   }
-  std::printf("ddipole GLSL vs C++ double: %d of %d compared (S > 1e-20 max = %.3g; %d front-lit, "
-              "%d back-lit; %d more are clamped to exactly 0 by the model), %d within 1e-4, %d "
-              "beyond it but within what float rounding of the inputs causes, %d neither; worst "
-              "relative error %.3g\n",
-              compared, kConfigs, 1e-20 * max_S, front, back, zero, within, conditioning, bad, worst);
+  std::printf(
+      "ddipole GLSL vs C++ double: %d of %d compared (S > 1e-20 max = %.3g; %d front-lit, "
+      "%d back-lit; %d more are clamped to exactly 0 by the model), %d within 1e-4, %d "
+      "beyond it but within what float rounding of the inputs causes, %d neither; worst "
+      "relative error %.3g\n",
+      compared, kConfigs, 1e-20 * max_S, front, back, zero, within, conditioning, bad, worst);
   EXPECT_EQ(bad, 0);
   // About a sixth of the configurations sit where S_d = max(0, real - virtual) is clamped to 0
   // (back-lit and far points); the rest, well above the 10^4 asked for, are compared.
@@ -389,8 +399,10 @@ TEST_F(GlslTwinTest, FresnelTransmittanceMatchesDoubleModel) {
           << "cos_i=" << c.w_i.dot(c.n_i) << " eta=" << c.medium.eta;
     }
   }
-  std::printf("Fresnel: %zu compared, %d near the critical angle beyond 2e-6 (within 4x the C++ "
-              "float error)\n", configs.size(), near_critical);
+  std::printf(
+      "Fresnel: %zu compared, %d near the critical angle beyond 2e-6 (within 4x the C++ "
+      "float error)\n",
+      configs.size(), near_critical);
   EXPECT_LT(near_critical, 40);
 }
 

@@ -1,6 +1,6 @@
 // Tests of render/src/reference_renderer.cpp, the CPU reference: physical sanity (finite, positive,
-// lit side brighter, linear in the light, rotation invariant), the accelerations against brute force,
-// and convergence as 1/sqrt(samples). Images are 32-48 px with a few thousand samples.
+// lit side brighter, linear in the light, rotation invariant), the accelerations against brute
+// force, and convergence as 1/sqrt(samples). Images are 32-48 px with a few thousand samples.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -72,7 +72,7 @@ TEST(ReferenceRenderer, LitSideIsBrighterAndEverythingFinite) {
     ASSERT_EQ(r.mask.size(), 32u * 32u);
     expect_finite_non_negative(r.image);
     const int object = int(std::count(r.mask.begin(), r.mask.end(), 1));
-    EXPECT_GT(object, 300);  // the sphere covers about half the frame at 4 radii
+    EXPECT_GT(object, 300);   // the sphere covers about half the frame at 4 radii
     EXPECT_EQ(r.mask[0], 0);  // corner: background
     EXPECT_EQ(r.image.at(0, 0, 0), 0.0f);
     // Light from +x, camera on +z: the right half (larger x in the image) is the lit one.
@@ -129,8 +129,8 @@ Scene rotated(Scene scene, const Eigen::Matrix3f& R) {
 
 TEST(ReferenceRenderer, RotatingEverythingTogetherChangesNothingButNoise) {
   const Scene scene = sphere_scene(32);
-  const Scene turned = rotated(scene, Eigen::AngleAxisf(0.7f, Vec3f(1, 2, 3).normalized())
-                                          .toRotationMatrix());
+  const Scene turned =
+      rotated(scene, Eigen::AngleAxisf(0.7f, Vec3f(1, 2, 3).normalized()).toRotationMatrix());
   const auto model = DiffusionModel::kDirectionalDipole;
   const ReferenceImage a = render_reference(scene, model, small_options(64000, 1));
   const double mean = masked_mean(a.image, a.mask);
@@ -189,10 +189,10 @@ double rms_error(const Scene& scene, DiffusionModel model, int samples, int seed
   return std::sqrt(mse);
 }
 
-// The error of one render is heavy-tailed (a sample that lands very near a pixel's point adds a spike
-// of S_d(r -> 0)), so each count is averaged over 8 seeds; the truth has 32 times the largest count.
-// Measured over 40 seeds: slope -0.60 for the standard dipole (the stratification over the area CDF
-// makes it a little steeper than -0.5), batches of 8 seeds within [-0.62, -0.57].
+// The error of one render is heavy-tailed (a sample that lands very near a pixel's point adds a
+// spike of S_d(r -> 0)), so each count is averaged over 8 seeds; the truth has 32 times the largest
+// count. Measured over 40 seeds: slope -0.60 for the standard dipole (the stratification over the
+// area CDF makes it a little steeper than -0.5), batches of 8 seeds within [-0.62, -0.57].
 TEST(ReferenceRenderer, ConvergesAsOneOverSqrtSamples) {
   const Scene scene = sphere_scene(32);
   const auto model = DiffusionModel::kDipole;

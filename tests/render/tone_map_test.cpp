@@ -17,7 +17,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("lucent-tone-test-" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("lucent-tone-test-" + std::to_string(::getpid()));
   fs::create_directories(dir);
   return dir / name;
 }

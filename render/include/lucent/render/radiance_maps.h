@@ -1,0 +1,137 @@
+// The directional-dipole radiance-map technique (seed 003, Dal Corso 2014, chapters 4-5; DESIGN
+// §7.1 and §7.2) on OpenGL 4.5: per frame,
+//   1. light map: positions, normals and depth of the mesh seen from every light (one layer each;
+//      orthographic fitted to the mesh for directional lights, perspective for point lights);
+//   2. radiance maps: the mesh from K Halton directions into a K-layer array in one instanced draw;
+//      every texel gathers its share of N of M exponentially biased disc samples around its point's
+//      projection in each light map, rotated per texel and per frame, and adds the sum to the
+//      previous frame's (ping-pong), up to T frames;
+//   2b. alpha-weighted blur into mip levels through texture views, the level chosen from the frame
+//      count;
+//   3. final: each fragment averages the layers that see it (shadow-sampler depth test, shrink
+//   along
+//      the layer plane against seams), adds the Fresnel-reflected environment, and is read back
+//      linear (or tone-mapped on screen by present()).
+// Units: mm for lengths (the scene's), the lights' radiance units for the result. Deviations from
+// the seed are documented where they are made (render/src/radiance_maps_sampling.h, the shaders).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "lucent/render/render_settings.h"
+#include "lucent/render/scene.h"
+
+namespace lucent::render {
+
+/// The pipeline's own knobs beyond RenderSettings (K, N, M, q, T, W_s, W_l, model, exposure).
+struct RadianceMapOptions {
+  /// Blur levels at the first frame, fewer as frames accumulate (seed §6.2.4: two passes at the
+  /// first frame, none at convergence); 0 = no blur.
+  int max_blur_level = 2;
+  /// Depth bias of the layer visibility test, in radiance-map texels of world size (seed §5.4.3).
+  float shadow_bias_texels = 1.5f;
+  /// Shrink of x_o along the layer plane against seams, in texels (seed §5.4.4: "one pixel").
+  float shrink_texels = 1.0f;
+  /// Seed 003 keeps one set of disc points and only rotates it per texel and per frame, so the
+  /// accumulation converges to a fixed N-point quadrature in the radius. When set, every frame
+  /// draws new radii too (the Halton disc shifted by a low-discrepancy offset per frame), and the
+  /// accumulated estimate converges to the disc integral itself as frames add up (an extension).
+  bool new_radii_each_frame = false;
+  /// Convergence: the first frame whose image differs from the previous one by less than this
+  /// relative RMS over object pixels (reported in the stats; rendering still runs to T frames).
+  double convergence_tolerance = 0.01;
+  /// glFinish and a wall clock around each stage (GL_TIME_ELAPSED queries are always recorded;
+  /// llvmpipe under-reports them).
+  bool time_stages = true;
+  /// Add F_r(eta, n_o . w_o) L_env(reflect(-w_o, n_o)) where the scene has an environment map.
+  bool environment_reflection = true;
+
+  std::string to_string() const;
+};
+
+/// Per-stage times, ms.
+struct StageTimes {
+  double light_map_ms = 0, radiance_map_ms = 0, mip_blur_ms = 0, final_ms = 0;
+  double total_ms() const { return light_map_ms + radiance_map_ms + mip_blur_ms + final_ms; }
+};
+
+struct RadianceMapStats {
+  std::string gl_renderer;           ///< GL_RENDERER | GL_VERSION
+  int frames = 0;                    ///< frames accumulated (t)
+  int frames_rendered = 0;           ///< render_frame() calls since the last restart
+  int convergence_frame = 0;         ///< first frame changing the image by < tolerance; 0: not yet
+  std::vector<double> frame_change;  ///< relative RMS change of the image at frames 2, 3, ...
+  double setup_ms = 0;               ///< programs, textures, mesh upload (wall clock)
+  StageTimes last_wall;              ///< the last frame, glFinish + wall clock
+  StageTimes sum_wall, sum_gpu;      ///< over accumulating frames (sum_gpu: GL_TIME_ELAPSED)
+  int light_map_renders = 0;         ///< the light map is rendered on restart only
+  double uncovered_fraction = 0;     ///< object pixels no layer sees (black holes, seed Fig. 5.22)
+  double sigma_star_per_mm = 0;      ///< disc bias sigma* = min sigma_tr / q
+  double disc_radius_mm = 0;         ///< R the M points were drawn in
+  double used_disc_radius_mm = 0;    ///< rho the N nearest points stand for
+  int samples_per_light = 0;         ///< N / L
+
+  /// Mean per accumulated frame (light map: per render of it).
+  StageTimes mean_wall() const;
+  StageTimes mean_gpu() const;
+  std::string to_string() const;
+};
+
+/// Frame-by-frame renderer for `lucent view` and tests. Every call needs the same current
+/// OpenGL 4.5 core context (GlContext::create_headless, or a window's); it throws lucent::Error on
+/// anything the context cannot do and on settings it cannot use.
+class RadianceMapRenderer {
+ public:
+  RadianceMapRenderer();
+  ~RadianceMapRenderer();
+  RadianceMapRenderer(const RadianceMapRenderer&) = delete;
+  RadianceMapRenderer& operator=(const RadianceMapRenderer&) = delete;
+
+  /// Uploads the mesh, builds programs and textures for `settings` (validated), starts
+  /// accumulating.
+  void setup(const Scene& scene, const RenderSettings& settings,
+             const RadianceMapOptions& options = {});
+
+  /// The viewer's camera; the radiance maps do not depend on it, so accumulation goes on.
+  void set_camera(const Camera& camera);
+  /// New lights (at most 16), or a new material: accumulation restarts.
+  void set_lights(const std::vector<Light>& lights);
+  void set_material(const materials::Material& material);
+  /// Discards the accumulated frames (call after any change the renderer cannot see).
+  void restart();
+
+  /// One frame: light map (after a restart), radiance maps and blur while fewer than T frames are
+  /// accumulated, then the final pass. Returns true if it accumulated a frame.
+  bool render_frame();
+  int accumulated_frames() const;
+  bool converged() const;  ///< T frames accumulated: further frames change nothing
+
+  /// The last final pass: linear RGB radiance, camera.width x camera.height, row 0 at the top.
+  ImageRgb read_image() const;
+  /// width * height: 1 where a pixel sees the object, 0 elsewhere (as ReferenceImage::mask).
+  std::vector<std::uint8_t> read_mask() const;
+  /// Draws the last final image tone-mapped (exposure, Reinhard, sRGB) into the currently bound
+  /// draw framebuffer over width x height pixels (the window of `lucent view`).
+  void present(float exposure, int width, int height) const;
+
+  const RadianceMapStats& stats() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Renders `scene` with the radiance-map technique in a headless context of its own: T frames, then
+/// the image: linear RGB radiance, camera.width x camera.height, row 0 at the top (exposure is the
+/// writer's business). Fills `stats` (pass timings: per-frame means of light map, radiance map, mip
+/// blur, final, plus the details of RadianceMapStats) when given.
+ImageRgb render_radiance_maps(const Scene& scene, const RenderSettings& settings,
+                              RenderStats* stats = nullptr);
+ImageRgb render_radiance_maps(const Scene& scene, const RenderSettings& settings,
+                              const RadianceMapOptions& options, RenderStats* stats,
+                              RadianceMapStats* details = nullptr);
+
+}  // namespace lucent::render

@@ -1,0 +1,80 @@
+// What a frame shows: a mesh, a material, lights, a camera. Shared by every technique (the real-time
+// radiance-map pipeline, the CPU reference) so that they render exactly the same scene.
+// Lengths: the mesh is scaled so that its bounding-box diagonal is object_size_mm (mm); the camera
+// distance is in bounding-sphere radii.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "lucent/materials/material.h"
+
+namespace lucent::render {
+
+using Vec3f = Eigen::Vector3f;
+
+/// An indexed triangle mesh with per-vertex normals, in mm after scaling.
+struct Mesh {
+  std::vector<Vec3f> positions;           ///< mm
+  std::vector<Vec3f> normals;             ///< unit, per vertex (area-weighted face normals if absent)
+  std::vector<std::array<unsigned, 3>> triangles;
+  std::string name;
+
+  Vec3f bounds_min() const;
+  Vec3f bounds_max() const;
+  Vec3f centre() const;                  ///< of the bounding box
+  float bounding_radius() const;         ///< of the bounding sphere around centre(), mm
+  double surface_area() const;           ///< mm^2
+};
+
+enum class LightType { kDirectional, kPoint };
+
+struct Light {
+  LightType type = LightType::kDirectional;
+  Vec3f direction{0, 0, 1};  ///< directional: unit, from the object toward the light
+  Vec3f position{0, 0, 0};   ///< point: mm, in the mesh's (scaled) frame
+  Vec3f radiance{1, 1, 1};   ///< directional: irradiance on a surface facing it (W/mm^2, relative);
+                             ///< point: intensity (W/sr, relative)
+};
+
+/// Orthographic light map / perspective camera conventions are the techniques' business; this is the
+/// viewer's camera: looking at `target` from `eye`, vertical field of view in degrees.
+struct Camera {
+  Vec3f eye{0, 0, 300};
+  Vec3f target{0, 0, 0};
+  Vec3f up{0, 1, 0};
+  float fov_y_deg = 35;
+  int width = 128, height = 128;  ///< pixels
+};
+
+/// `--view AZ,EL,DIST`: azimuth and elevation in degrees, distance in bounding-sphere radii, looking
+/// at the mesh's centre.
+Camera orbit_camera(const Mesh& mesh, float azimuth_deg, float elevation_deg, float distance_radii,
+                    int width, int height);
+
+struct Scene {
+  Mesh mesh;
+  materials::Material material;
+  std::vector<Light> lights;
+  Camera camera;
+  /// Environment map shown as the background (linear RGB, lat-long), optional; its light enters
+  /// through `lights` (importance-sampled directional lights).
+  std::optional<std::filesystem::path> environment;
+};
+
+/// Parses `directional:DX,DY,DZ:R,G,B` or `point:X,Y,Z:R,G,B`; throws lucent::Error naming --light.
+Light parse_light(const std::string& text);
+
+/// Built-in meshes and files: "sphere", "bunny", "dragon:1".."dragon:4" (1 finest; from the npm data
+/// cache, $LUCENT_DATA_CACHE or ~/.cache/lucent), or a path to a PLY or OBJ file (Assimp). The mesh
+/// is centred and scaled so that its bounding-box diagonal is `object_size_mm`. Empty meshes throw;
+/// non-manifold ones load with a warning on stderr.
+Mesh load_mesh(const std::string& name_or_path, double object_size_mm = 100.0);
+
+}  // namespace lucent::render

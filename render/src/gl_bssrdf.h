@@ -1,0 +1,33 @@
+// The BSSRDF coefficients as the GLSL twins (render/shaders/bssrdf_ddipole.glsl,
+// bssrdf_dipole.glsl) receive them: derived on the CPU in double by materials::derive_coefficients
+// and rounded once to float, as the C++ float models do.
+#pragma once
+
+#include <array>
+
+#include "gl_api.h"
+#include "lucent/materials/material.h"
+#include "lucent/materials/medium.h"
+
+namespace lucent::render::gl {
+
+/// std430 image of GLSL `DdipoleChannel` (same member order).
+struct DdipoleChannelData {
+  float alpha_prime, eta, D, sigma_tr, sigma_t, d_e, C_phi, C_E, A, normalisation;
+};
+static_assert(sizeof(DdipoleChannelData) == 10 * sizeof(float));
+
+/// std430 image of GLSL `DipoleChannel` (same member order).
+struct DipoleChannelData {
+  float alpha_prime, sigma_tr, z_r, z_v;
+};
+static_assert(sizeof(DipoleChannelData) == 4 * sizeof(float));
+
+DdipoleChannelData ddipole_channel_data(const materials::Medium<double>& medium);
+DipoleChannelData dipole_channel_data(const materials::Medium<double>& medium);
+
+/// Sets `u_ddipole[0..2]` and `u_dipole[0..2]` (uniform arrays of the structs above) and `u_eta` in
+/// `program` (which must be in use) from the material's three channels.
+void set_bssrdf_uniforms(GLuint program, const materials::Material& material);
+
+}  // namespace lucent::render::gl

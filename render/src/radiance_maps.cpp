@@ -1,0 +1,859 @@
+// The radiance-map pipeline of seed 003 on OpenGL 4.5
+// (render/include/lucent/render/radiance_maps.h).
+#include "lucent/render/radiance_maps.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+#include "gl_api.h"
+#include "gl_bssrdf.h"
+#include "gl_program.h"
+#include "lucent/materials/error.h"
+#include "lucent/render/environment.h"
+#include "lucent/render/gl_context.h"
+#include "radiance_maps_sampling.h"
+
+namespace lucent::render {
+
+namespace {
+
+constexpr int kMaxLights = 16;
+// Texture units.
+constexpr GLuint kUnitLightPositions = 0, kUnitLightNormals = 1, kUnitPrevious = 2;
+constexpr GLuint kUnitRadiance = 0, kUnitRadianceDepth = 1, kUnitEnvironment = 2;
+// Uniform-block bindings (as in the shaders).
+constexpr GLuint kLightMatricesBinding = 0, kLayerCamerasBinding = 1, kDiscSamplesBinding = 2;
+
+enum Stage { kLightMap, kRadianceMap, kMipBlur, kFinal, kStageCount };
+
+double& stage_field(StageTimes& t, int stage) {
+  switch (stage) {
+    case kLightMap:
+      return t.light_map_ms;
+    case kRadianceMap:
+      return t.radiance_map_ms;
+    case kMipBlur:
+      return t.mip_blur_ms;
+    default:
+      return t.final_ms;
+  }
+}
+
+double now_ms() {
+  using clock = std::chrono::steady_clock;
+  return std::chrono::duration<double, std::milli>(clock::now().time_since_epoch()).count();
+}
+
+}  // namespace
+
+std::string RadianceMapOptions::to_string() const {
+  std::ostringstream s;
+  s << "RadianceMapOptions{max_blur_level=" << max_blur_level
+    << ", shadow_bias_texels=" << shadow_bias_texels << ", shrink_texels=" << shrink_texels
+    << ", new_radii_each_frame=" << new_radii_each_frame
+    << ", convergence_tolerance=" << convergence_tolerance << ", time_stages=" << time_stages
+    << ", environment_reflection=" << environment_reflection << "}";
+  return s.str();
+}
+
+StageTimes RadianceMapStats::mean_wall() const {
+  StageTimes m = sum_wall;
+  const double f = std::max(frames, 1);
+  m.light_map_ms /= std::max(light_map_renders, 1);
+  m.radiance_map_ms /= f;
+  m.mip_blur_ms /= f;
+  m.final_ms /= std::max(frames_rendered, 1);
+  return m;
+}
+
+StageTimes RadianceMapStats::mean_gpu() const {
+  StageTimes m = sum_gpu;
+  const double f = std::max(frames, 1);
+  m.light_map_ms /= std::max(light_map_renders, 1);
+  m.radiance_map_ms /= f;
+  m.mip_blur_ms /= f;
+  m.final_ms /= std::max(frames_rendered, 1);
+  return m;
+}
+
+std::string RadianceMapStats::to_string() const {
+  const StageTimes w = mean_wall(), g = mean_gpu();
+  std::ostringstream s;
+  s.precision(4);
+  s << "RadianceMapStats{" << gl_renderer << "; frames=" << frames
+    << ", convergence_frame=" << convergence_frame << ", setup=" << setup_ms
+    << "ms; per frame (glFinish + wall clock): light map " << w.light_map_ms << "ms, radiance map "
+    << w.radiance_map_ms << "ms, mip blur " << w.mip_blur_ms << "ms, final " << w.final_ms
+    << "ms; GL_TIME_ELAPSED: " << g.light_map_ms << ", " << g.radiance_map_ms << ", "
+    << g.mip_blur_ms << ", " << g.final_ms << "ms; uncovered " << uncovered_fraction
+    << "; sigma*=" << sigma_star_per_mm << "/mm, R=" << disc_radius_mm
+    << "mm, rho=" << used_disc_radius_mm << "mm, N/L=" << samples_per_light << "}";
+  return s.str();
+}
+
+struct RadianceMapRenderer::Impl {
+  Scene scene;
+  RenderSettings settings;
+  RadianceMapOptions options;
+  Vec3f centre{0, 0, 0};
+  float radius_mm = 1;
+  int K = 0, L = 0;
+  int final_width = 0, final_height = 0;
+
+  gl::VertexArray mesh_vao, empty_vao;
+  gl::Buffer positions, normals, indices;
+  GLsizei index_count = 0;
+
+  gl::Program light_map_program, radiance_program, blur_program, final_program, background_program,
+      present_program;
+
+  gl::Buffer light_matrices, layer_cameras, disc_buffer;
+  gl::Texture light_positions, light_normals, light_depth;
+  gl::Framebuffer light_fbo;
+
+  std::array<gl::Texture, 2> radiance;
+  gl::Texture radiance_depth;
+  std::array<gl::Framebuffer, 2> radiance_fbo;
+  int levels = 1;
+  std::array<std::vector<gl::Texture>, 2> level_views;     // [buffer][l]: level l alone
+  std::array<std::vector<gl::Framebuffer>, 2> level_fbos;  // [buffer][l]: draws level l + 1
+
+  gl::Sampler nearest, linear_clamp, mip_nearest, shadow, environment_sampler;
+  gl::Texture final_color;
+  gl::Renderbuffer final_depth;
+  gl::Framebuffer final_fbo;
+  gl::Texture environment;
+  bool has_environment = false;
+
+  std::vector<detail::LayerCamera> layer_cams, light_cams;
+  detail::DiscSamples disc;
+
+  std::array<gl::Query, kStageCount> queries;
+  int frame = 0;    // accumulated
+  int current = 0;  // ping-pong buffer holding the latest sum
+  int level = 0;    // blur level of the last final pass
+  bool light_map_valid = false;
+  std::vector<float> last_image;
+  RadianceMapStats stats;
+
+  void build(const Scene& s, const RenderSettings& rs, const RadianceMapOptions& o);
+  void upload_mesh();
+  void build_programs();
+  void build_light_maps();
+  void build_radiance_maps();
+  void build_final();
+  void upload_lights();
+  void upload_material();
+  void upload_disc(int t);
+  void upload_layers();
+  void render_light_map();
+  void render_radiance_depth();
+  void render_radiance();
+  void render_blur();
+  void render_final();
+  template <typename F>
+  void timed(int stage, F&& work);
+  std::vector<float> read_rgba() const;
+  void record_convergence();
+};
+
+RadianceMapRenderer::RadianceMapRenderer() : impl_(std::make_unique<Impl>()) {}
+RadianceMapRenderer::~RadianceMapRenderer() = default;
+
+void RadianceMapRenderer::setup(const Scene& scene, const RenderSettings& settings,
+                                const RadianceMapOptions& options) {
+  const double t0 = now_ms();
+  impl_ = std::make_unique<Impl>();
+  impl_->build(scene, settings, options);
+  glFinish();
+  impl_->stats.setup_ms = now_ms() - t0;
+}
+
+void RadianceMapRenderer::Impl::build(const Scene& s, const RenderSettings& rs,
+                                      const RadianceMapOptions& o) {
+  scene = s;
+  settings = rs;
+  options = o;
+  settings.validate();
+  if (scene.mesh.positions.empty() || scene.mesh.triangles.empty()) {
+    throw Error("radiance maps: the mesh '" + scene.mesh.name + "' is empty");
+  }
+  if (scene.mesh.normals.size() != scene.mesh.positions.size()) {
+    throw Error("radiance maps: the mesh '" + scene.mesh.name + "' has no per-vertex normals");
+  }
+  if (scene.lights.empty()) throw Error("--light: the radiance maps need at least one light");
+  if (int(scene.lights.size()) > kMaxLights) {
+    throw Error("--light: the radiance maps take at most " + std::to_string(kMaxLights) +
+                " lights, got " + std::to_string(scene.lights.size()));
+  }
+  if (options.max_blur_level < 0) throw Error("radiance maps: max_blur_level must be >= 0");
+  K = settings.directions;
+  L = int(scene.lights.size());
+  GLint max_block = 0;
+  glGetIntegerv(GL_MAX_UNIFORM_BLOCK_SIZE, &max_block);
+  if (K * 80 > max_block) {
+    throw Error("--directions: this OpenGL allows at most " + std::to_string(max_block / 80) +
+                " radiance-map directions, got " + std::to_string(K));
+  }
+  if (settings.samples * 16 > max_block) {
+    throw Error("--samples: this OpenGL allows at most " + std::to_string(max_block / 16) +
+                " disc samples, got " + std::to_string(settings.samples));
+  }
+  centre = scene.mesh.centre();
+  radius_mm = scene.mesh.bounding_radius();
+  stats.gl_renderer = std::string(reinterpret_cast<const char*>(glGetString(GL_RENDERER))) + " | " +
+                      reinterpret_cast<const char*>(glGetString(GL_VERSION));
+
+  upload_mesh();
+  build_programs();
+  build_light_maps();
+  build_radiance_maps();
+  build_final();
+  upload_layers();
+  upload_material();  // and the lights with it (the disc depends on both)
+  for (auto& q : queries) q = gl::create_query(GL_TIME_ELAPSED);
+  render_radiance_depth();
+  // One untimed pass of every program, so that drivers that compile shaders at their first draw
+  // (llvmpipe's JIT, most GPU drivers) do it here and not inside the first frame's timings (seed
+  // §6.3 likewise leaves the first frames out of its timings).
+  render_light_map();
+  level = levels - 1;
+  render_blur();
+  level = 0;
+  render_final();
+  gl::check_errors("radiance-map setup");
+}
+
+void RadianceMapRenderer::Impl::upload_mesh() {
+  const Mesh& m = scene.mesh;
+  mesh_vao = gl::create_vertex_array();
+  empty_vao = gl::create_vertex_array();
+  positions = gl::create_buffer();
+  normals = gl::create_buffer();
+  indices = gl::create_buffer();
+  glNamedBufferStorage(positions.id(), GLsizeiptr(m.positions.size() * sizeof(Vec3f)),
+                       m.positions.data(), 0);
+  glNamedBufferStorage(normals.id(), GLsizeiptr(m.normals.size() * sizeof(Vec3f)), m.normals.data(),
+                       0);
+  glNamedBufferStorage(indices.id(), GLsizeiptr(m.triangles.size() * sizeof(m.triangles[0])),
+                       m.triangles.data(), 0);
+  static_assert(sizeof(Vec3f) == 3 * sizeof(float));
+  index_count = GLsizei(m.triangles.size() * 3);
+  const GLuint vao = mesh_vao.id();
+  glVertexArrayVertexBuffer(vao, 0, positions.id(), 0, sizeof(Vec3f));
+  glVertexArrayVertexBuffer(vao, 1, normals.id(), 0, sizeof(Vec3f));
+  glVertexArrayElementBuffer(vao, indices.id());
+  for (GLuint a = 0; a < 2; ++a) {
+    glEnableVertexArrayAttrib(vao, a);
+    glVertexArrayAttribFormat(vao, a, 3, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(vao, a, a);
+  }
+}
+
+void RadianceMapRenderer::Impl::build_programs() {
+  const std::vector<std::string> defines = {
+      "LUCENT_MAX_LIGHTS " + std::to_string(kMaxLights),
+      "LUCENT_MAX_DIRECTIONS " + std::to_string(K),
+      "LUCENT_MAX_DISC_SAMPLES " + std::to_string(settings.samples),
+      settings.model == DiffusionModel::kDipole ? "LUCENT_MODEL_DIPOLE" : "LUCENT_MODEL_DDIPOLE"};
+  light_map_program = gl::Program({{GL_VERTEX_SHADER, "layered_mesh.vert"},
+                                   {GL_GEOMETRY_SHADER, "light_map.geom"},
+                                   {GL_FRAGMENT_SHADER, "light_map.frag"}},
+                                  defines);
+  radiance_program = gl::Program({{GL_VERTEX_SHADER, "layered_mesh.vert"},
+                                  {GL_GEOMETRY_SHADER, "radiance_map.geom"},
+                                  {GL_FRAGMENT_SHADER, "radiance_map.frag"}},
+                                 defines);
+  blur_program = gl::Program({{GL_VERTEX_SHADER, "fullscreen_layers.vert"},
+                              {GL_GEOMETRY_SHADER, "mip_blur.geom"},
+                              {GL_FRAGMENT_SHADER, "mip_blur.frag"}},
+                             defines);
+  final_program =
+      gl::Program({{GL_VERTEX_SHADER, "final.vert"}, {GL_FRAGMENT_SHADER, "final.frag"}}, defines);
+  background_program = gl::Program(
+      {{GL_VERTEX_SHADER, "background.vert"}, {GL_FRAGMENT_SHADER, "background.frag"}}, defines);
+  present_program = gl::Program(
+      {{GL_VERTEX_SHADER, "background.vert"}, {GL_FRAGMENT_SHADER, "present.frag"}}, defines);
+
+  const auto unit = [](const gl::Program& p, const char* name, GLint u) {
+    glProgramUniform1i(p.id(), p.location(name), u);
+  };
+  unit(radiance_program, "u_light_positions", kUnitLightPositions);
+  unit(radiance_program, "u_light_normals", kUnitLightNormals);
+  unit(radiance_program, "u_previous", kUnitPrevious);
+  unit(blur_program, "u_source", 0);
+  unit(final_program, "u_radiance", kUnitRadiance);
+  unit(final_program, "u_radiance_depth", kUnitRadianceDepth);
+  unit(final_program, "u_environment", kUnitEnvironment);
+  unit(background_program, "u_environment", kUnitEnvironment);
+  unit(present_program, "u_image", 0);
+
+  nearest = gl::create_sampler();
+  for (const gl::Sampler* s : {&nearest}) {
+    glSamplerParameteri(s->id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glSamplerParameteri(s->id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glSamplerParameteri(s->id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glSamplerParameteri(s->id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  }
+  linear_clamp = gl::create_sampler();
+  glSamplerParameteri(linear_clamp.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glSamplerParameteri(linear_clamp.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glSamplerParameteri(linear_clamp.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glSamplerParameteri(linear_clamp.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  // The final pass reads one whole level (u_mip_level is an integer): bilinear within it.
+  mip_nearest = gl::create_sampler();
+  glSamplerParameteri(mip_nearest.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
+  glSamplerParameteri(mip_nearest.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glSamplerParameteri(mip_nearest.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glSamplerParameteri(mip_nearest.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  // Seed Listing 5.9: compare against the stored depth; nearest, as the seed.
+  shadow = gl::create_sampler();
+  glSamplerParameteri(shadow.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glSamplerParameteri(shadow.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glSamplerParameteri(shadow.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glSamplerParameteri(shadow.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glSamplerParameteri(shadow.id(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+  glSamplerParameteri(shadow.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+  // Lat-long: wrap in u, clamp in v (as environment_lookup on the CPU).
+  environment_sampler = gl::create_sampler();
+  glSamplerParameteri(environment_sampler.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glSamplerParameteri(environment_sampler.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glSamplerParameteri(environment_sampler.id(), GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glSamplerParameteri(environment_sampler.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+}
+
+void RadianceMapRenderer::Impl::build_light_maps() {
+  const int W = settings.light_map_size;
+  light_positions = gl::create_texture(GL_TEXTURE_2D_ARRAY);
+  light_normals = gl::create_texture(GL_TEXTURE_2D_ARRAY);
+  light_depth = gl::create_texture(GL_TEXTURE_2D_ARRAY);
+  glTextureStorage3D(light_positions.id(), 1, GL_RGBA32F, W, W, L);
+  glTextureStorage3D(light_normals.id(), 1, GL_RGBA32F, W, W, L);
+  glTextureStorage3D(light_depth.id(), 1, GL_DEPTH_COMPONENT32F, W, W, L);
+  light_fbo = gl::create_framebuffer();
+  glNamedFramebufferTexture(light_fbo.id(), GL_COLOR_ATTACHMENT0, light_positions.id(), 0);
+  glNamedFramebufferTexture(light_fbo.id(), GL_COLOR_ATTACHMENT1, light_normals.id(), 0);
+  glNamedFramebufferTexture(light_fbo.id(), GL_DEPTH_ATTACHMENT, light_depth.id(), 0);
+  const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  glNamedFramebufferDrawBuffers(light_fbo.id(), 2, buffers);
+  gl::check_framebuffer(light_fbo.id(), "the light map");
+  light_matrices = gl::create_buffer();
+  glNamedBufferStorage(light_matrices.id(), kMaxLights * sizeof(detail::Mat4f), nullptr,
+                       GL_DYNAMIC_STORAGE_BIT);
+}
+
+void RadianceMapRenderer::Impl::build_radiance_maps() {
+  const int W = settings.radiance_map_size;
+  levels = 1;
+  while (levels <= options.max_blur_level && (W >> levels) >= 1) ++levels;
+  radiance_depth = gl::create_texture(GL_TEXTURE_2D_ARRAY);
+  glTextureStorage3D(radiance_depth.id(), 1, GL_DEPTH_COMPONENT32F, W, W, K);
+  for (int b = 0; b < 2; ++b) {
+    radiance[b] = gl::create_texture(GL_TEXTURE_2D_ARRAY);
+    glTextureStorage3D(radiance[b].id(), levels, GL_RGBA32F, W, W, K);
+    radiance_fbo[b] = gl::create_framebuffer();
+    // Both ping-pong buffers share one depth array (seed §5.3.6): the geometry does not change.
+    glNamedFramebufferTexture(radiance_fbo[b].id(), GL_COLOR_ATTACHMENT0, radiance[b].id(), 0);
+    glNamedFramebufferTexture(radiance_fbo[b].id(), GL_DEPTH_ATTACHMENT, radiance_depth.id(), 0);
+    gl::check_framebuffer(radiance_fbo[b].id(), "the radiance maps");
+    level_views[b].clear();
+    level_fbos[b].clear();
+    for (int l = 0; l + 1 < levels; ++l) {
+      // A view of level l alone to sample while level l + 1 of the same storage is drawn (GL
+      // forbids sampling a texture bound for drawing, whatever the levels; seed §5.4.2).
+      GLuint view = 0;
+      glGenTextures(1, &view);
+      glTextureView(view, GL_TEXTURE_2D_ARRAY, radiance[b].id(), GL_RGBA32F, GLuint(l), 1, 0,
+                    GLuint(K));
+      level_views[b].emplace_back(view);
+      gl::Framebuffer fbo = gl::create_framebuffer();
+      glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT0, radiance[b].id(), l + 1);
+      gl::check_framebuffer(fbo.id(), "a radiance-map mip level");
+      level_fbos[b].push_back(std::move(fbo));
+    }
+  }
+  layer_cameras = gl::create_buffer();
+  glNamedBufferStorage(layer_cameras.id(), GLsizeiptr(K * 80), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  disc_buffer = gl::create_buffer();
+  glNamedBufferStorage(disc_buffer.id(), GLsizeiptr(settings.samples * 16), nullptr,
+                       GL_DYNAMIC_STORAGE_BIT);
+}
+
+void RadianceMapRenderer::Impl::build_final() {
+  final_width = scene.camera.width;
+  final_height = scene.camera.height;
+  if (final_width < 1 || final_height < 1) throw Error("--size: the image has no pixels");
+  final_color = gl::create_texture(GL_TEXTURE_2D);
+  glTextureStorage2D(final_color.id(), 1, GL_RGBA32F, final_width, final_height);
+  glTextureParameteri(final_color.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(final_color.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  final_depth = gl::create_renderbuffer();
+  glNamedRenderbufferStorage(final_depth.id(), GL_DEPTH_COMPONENT32F, final_width, final_height);
+  final_fbo = gl::create_framebuffer();
+  glNamedFramebufferTexture(final_fbo.id(), GL_COLOR_ATTACHMENT0, final_color.id(), 0);
+  glNamedFramebufferRenderbuffer(final_fbo.id(), GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
+                                 final_depth.id());
+  gl::check_framebuffer(final_fbo.id(), "the final image");
+
+  has_environment = false;
+  if (scene.environment) {
+    const EnvironmentMap map = load_environment(*scene.environment);
+    environment = gl::create_texture(GL_TEXTURE_2D);
+    glTextureStorage2D(environment.id(), 1, GL_RGB32F, map.image.width, map.image.height);
+    // Row 0 (the top, theta = 0) goes to t = 0, so v = theta / pi reads it directly.
+    glTextureSubImage2D(environment.id(), 0, 0, 0, map.image.width, map.image.height, GL_RGB,
+                        GL_FLOAT, map.image.data.data());
+    has_environment = true;
+  }
+}
+
+void RadianceMapRenderer::Impl::upload_layers() {
+  const std::vector<Vec3f> directions = detail::halton_sphere_directions(K);
+  layer_cams.clear();
+  std::vector<float> block(std::size_t(K) * 20, 0.0f);
+  for (int k = 0; k < K; ++k) {
+    layer_cams.push_back(detail::fitted_orthographic(centre, radius_mm, directions[k]));
+    std::copy_n(layer_cams[k].view_proj.data(), 16, &block[std::size_t(k) * 16]);
+    const Vec3f& d = layer_cams[k].direction;
+    float* v = &block[std::size_t(K) * 16 + std::size_t(k) * 4];
+    v[0] = d.x();
+    v[1] = d.y();
+    v[2] = d.z();
+  }
+  glNamedBufferSubData(layer_cameras.id(), 0, GLsizeiptr(block.size() * sizeof(float)),
+                       block.data());
+}
+
+void RadianceMapRenderer::Impl::upload_lights() {
+  L = int(scene.lights.size());
+  light_cams.clear();
+  std::vector<float> matrices(std::size_t(kMaxLights) * 16, 0.0f);
+  std::vector<float> position(std::size_t(kMaxLights) * 4, 0.0f),
+      radiance_(std::size_t(kMaxLights) * 3, 0.0f);
+  for (int l = 0; l < L; ++l) {
+    const Light& light = scene.lights[std::size_t(l)];
+    if (light.type == LightType::kDirectional) {
+      const Vec3f d = light.direction.normalized();
+      light_cams.push_back(detail::fitted_orthographic(centre, radius_mm, d));
+      position[std::size_t(l) * 4 + 0] = d.x();
+      position[std::size_t(l) * 4 + 1] = d.y();
+      position[std::size_t(l) * 4 + 2] = d.z();
+      position[std::size_t(l) * 4 + 3] = 0;
+    } else {
+      light_cams.push_back(detail::fitted_perspective(centre, radius_mm, light.position));
+      for (int c = 0; c < 3; ++c) position[std::size_t(l) * 4 + std::size_t(c)] = light.position[c];
+      position[std::size_t(l) * 4 + 3] = 1;
+    }
+    for (int c = 0; c < 3; ++c) radiance_[std::size_t(l) * 3 + std::size_t(c)] = light.radiance[c];
+    std::copy_n(light_cams.back().view_proj.data(), 16, &matrices[std::size_t(l) * 16]);
+  }
+  glNamedBufferSubData(light_matrices.id(), 0, GLsizeiptr(matrices.size() * sizeof(float)),
+                       matrices.data());
+  const GLuint p = radiance_program.id();
+  glProgramUniform1i(p, radiance_program.location("u_light_count"), L);
+  glProgramUniform4fv(p, radiance_program.location("u_light_position"), kMaxLights,
+                      position.data());
+  glProgramUniform3fv(p, radiance_program.location("u_light_radiance"), kMaxLights,
+                      radiance_.data());
+
+  upload_disc(1);
+}
+
+void RadianceMapRenderer::Impl::upload_disc(int t) {
+  // The disc: radius of the mesh's bounding box diagonal (seed §5.3.4.1: "a radius equal to the
+  // size of the bounding box"), shared round-robin by the lights.
+  const double box = (scene.mesh.bounds_max() - scene.mesh.bounds_min()).norm();
+  disc = detail::exponential_disc_samples(settings.disc_points, settings.samples,
+                                          detail::sigma_star(scene.material, settings.q), box, L,
+                                          detail::frame_shift(t));
+  std::vector<float> packed(std::size_t(settings.samples) * 4, 0.0f);
+  for (std::size_t i = 0; i < disc.samples.size(); ++i) {
+    packed[i * 4 + 0] = disc.samples[i].x_mm;
+    packed[i * 4 + 1] = disc.samples[i].y_mm;
+    packed[i * 4 + 2] = disc.samples[i].weight_mm2;
+  }
+  glNamedBufferSubData(disc_buffer.id(), 0, GLsizeiptr(packed.size() * sizeof(float)),
+                       packed.data());
+  std::vector<GLint> offset(kMaxLights, 0), count(kMaxLights, 0);
+  for (int l = 0; l < L; ++l) {
+    offset[std::size_t(l)] = disc.light_offset[std::size_t(l)];
+    count[std::size_t(l)] = disc.light_count[std::size_t(l)];
+  }
+  const GLuint p = radiance_program.id();
+  glProgramUniform1iv(p, radiance_program.location("u_light_sample_offset"), kMaxLights,
+                      offset.data());
+  glProgramUniform1iv(p, radiance_program.location("u_light_sample_count"), kMaxLights,
+                      count.data());
+  stats.sigma_star_per_mm = disc.sigma_star_per_mm;
+  stats.disc_radius_mm = disc.disc_radius_mm;
+  stats.used_disc_radius_mm = disc.used_radius_mm;
+  stats.samples_per_light = disc.light_count.empty() ? 0 : disc.light_count[0];
+}
+
+void RadianceMapRenderer::Impl::upload_material() {
+  gl::set_bssrdf_uniforms(radiance_program.id(), scene.material);
+  glProgramUniform1f(final_program.id(), final_program.location("u_eta"),
+                     float(scene.material.ior));
+  // sigma* depends on the material: the disc is rebuilt with the lights.
+  upload_lights();
+}
+
+template <typename F>
+void RadianceMapRenderer::Impl::timed(int stage, F&& work) {
+  if (options.time_stages) glFinish();
+  const double t0 = now_ms();
+  glBeginQuery(GL_TIME_ELAPSED, queries[std::size_t(stage)].id());
+  work();
+  glEndQuery(GL_TIME_ELAPSED);
+  if (options.time_stages) glFinish();
+  const double wall = now_ms() - t0;
+  GLuint64 ns = 0;
+  glGetQueryObjectui64v(queries[std::size_t(stage)].id(), GL_QUERY_RESULT, &ns);
+  stage_field(stats.last_wall, stage) = wall;
+  stage_field(stats.sum_wall, stage) += wall;
+  stage_field(stats.sum_gpu, stage) += double(ns) * 1e-6;
+}
+
+void RadianceMapRenderer::Impl::render_light_map() {
+  const int W = settings.light_map_size;
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, light_fbo.id());
+  glViewport(0, 0, W, W);
+  const float zero[4] = {0, 0, 0, 0};
+  const float one = 1.0f;
+  glClearNamedFramebufferfv(light_fbo.id(), GL_COLOR, 0, zero);
+  glClearNamedFramebufferfv(light_fbo.id(), GL_COLOR, 1, zero);
+  glClearNamedFramebufferfv(light_fbo.id(), GL_DEPTH, 0, &one);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  glDisable(GL_BLEND);
+  light_map_program.use();
+  glBindBufferBase(GL_UNIFORM_BUFFER, kLightMatricesBinding, light_matrices.id());
+  glBindVertexArray(mesh_vao.id());
+  glDrawElementsInstanced(GL_TRIANGLES, index_count, GL_UNSIGNED_INT, nullptr, L);
+}
+
+void RadianceMapRenderer::Impl::render_radiance_depth() {
+  // Depth pre-pass into the shared depth array, once: the radiance pass then tests GL_LEQUAL with
+  // early fragment tests, so only the surface each texel sees runs the expensive gather.
+  const int W = settings.radiance_map_size;
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, radiance_fbo[0].id());
+  glViewport(0, 0, W, W);
+  const float one = 1.0f;
+  glClearNamedFramebufferfv(radiance_fbo[0].id(), GL_DEPTH, 0, &one);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  radiance_program.use();
+  glProgramUniform1i(radiance_program.id(), radiance_program.location("u_depth_only"), 1);
+  glBindBufferBase(GL_UNIFORM_BUFFER, kLayerCamerasBinding, layer_cameras.id());
+  glBindVertexArray(mesh_vao.id());
+  glDrawElementsInstanced(GL_TRIANGLES, index_count, GL_UNSIGNED_INT, nullptr, K);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glProgramUniform1i(radiance_program.id(), radiance_program.location("u_depth_only"), 0);
+}
+
+void RadianceMapRenderer::Impl::render_radiance() {
+  // Frame t (1-based) writes buffer t % 2 and reads the sum so far from the other (seed §5.3.3).
+  const int t = frame;
+  const int target = t % 2, previous = 1 - target;
+  if (options.new_radii_each_frame) upload_disc(t);
+  const int W = settings.radiance_map_size;
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, radiance_fbo[target].id());
+  glViewport(0, 0, W, W);
+  const float zero[4] = {0, 0, 0, 0};
+  glClearNamedFramebufferfv(radiance_fbo[target].id(), GL_COLOR, 0, zero);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LEQUAL);
+  glDepthMask(GL_FALSE);
+  radiance_program.use();
+  const GLuint p = radiance_program.id();
+  glProgramUniform1i(p, radiance_program.location("u_has_previous"), t > 1 ? 1 : 0);
+  glProgramUniform1f(p, radiance_program.location("u_rotation_offset"),
+                     float(t - 1) / float(settings.frames));
+  glBindBufferBase(GL_UNIFORM_BUFFER, kLightMatricesBinding, light_matrices.id());
+  glBindBufferBase(GL_UNIFORM_BUFFER, kLayerCamerasBinding, layer_cameras.id());
+  glBindBufferBase(GL_UNIFORM_BUFFER, kDiscSamplesBinding, disc_buffer.id());
+  glBindTextureUnit(kUnitLightPositions, light_positions.id());
+  glBindSampler(kUnitLightPositions, nearest.id());
+  glBindTextureUnit(kUnitLightNormals, light_normals.id());
+  glBindSampler(kUnitLightNormals, nearest.id());
+  glBindTextureUnit(kUnitPrevious, radiance[previous].id());
+  glBindSampler(kUnitPrevious, nearest.id());
+  glBindVertexArray(mesh_vao.id());
+  glDrawElementsInstanced(GL_TRIANGLES, index_count, GL_UNSIGNED_INT, nullptr, K);
+  glDepthMask(GL_TRUE);
+  current = target;
+}
+
+void RadianceMapRenderer::Impl::render_blur() {
+  glDisable(GL_DEPTH_TEST);
+  blur_program.use();
+  glBindVertexArray(empty_vao.id());
+  const int W = settings.radiance_map_size;
+  for (int l = 0; l < level; ++l) {
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, level_fbos[current][std::size_t(l)].id());
+    glViewport(0, 0, std::max(W >> (l + 1), 1), std::max(W >> (l + 1), 1));
+    glBindTextureUnit(0, level_views[current][std::size_t(l)].id());
+    glBindSampler(0, linear_clamp.id());
+    glDrawArraysInstanced(GL_TRIANGLES, 0, 3, K);
+  }
+}
+
+void RadianceMapRenderer::Impl::render_final() {
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, final_fbo.id());
+  glViewport(0, 0, final_width, final_height);
+  const float one = 1.0f;
+  glClearNamedFramebufferfv(final_fbo.id(), GL_DEPTH, 0, &one);
+  const detail::Mat4f view_proj = detail::camera_view_proj(scene.camera, centre, radius_mm);
+
+  glDisable(GL_DEPTH_TEST);
+  background_program.use();
+  const detail::Mat4f inverse = view_proj.inverse();
+  glUniformMatrix4fv(background_program.location("u_inverse_view_proj"), 1, GL_FALSE,
+                     inverse.data());
+  glUniform1i(background_program.location("u_has_environment"), has_environment ? 1 : 0);
+  if (has_environment) {
+    glBindTextureUnit(kUnitEnvironment, environment.id());
+    glBindSampler(kUnitEnvironment, environment_sampler.id());
+  }
+  glBindVertexArray(empty_vao.id());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  final_program.use();
+  const float texel_mm = 2.0f * radius_mm * 1.02f / float(settings.radiance_map_size);
+  const detail::LayerCamera& any_layer = layer_cams.front();
+  glUniformMatrix4fv(final_program.location("u_view_proj"), 1, GL_FALSE, view_proj.data());
+  glUniform1i(final_program.location("u_layer_count"), K);
+  glUniform1f(final_program.location("u_mip_level"), float(level));
+  glUniform1f(final_program.location("u_depth_bias_mm"), options.shadow_bias_texels * texel_mm);
+  glUniform1f(final_program.location("u_texel_mm"), texel_mm);
+  glUniform1f(final_program.location("u_depth_range_mm"), any_layer.far_mm - any_layer.near_mm);
+  glUniform1f(final_program.location("u_shrink_mm"), options.shrink_texels * texel_mm);
+  glUniform3fv(final_program.location("u_eye"), 1, scene.camera.eye.data());
+  glUniform1i(final_program.location("u_has_environment"),
+              has_environment && options.environment_reflection ? 1 : 0);
+  glBindBufferBase(GL_UNIFORM_BUFFER, kLayerCamerasBinding, layer_cameras.id());
+  glBindTextureUnit(kUnitRadiance, radiance[current].id());
+  glBindSampler(kUnitRadiance, mip_nearest.id());
+  glBindTextureUnit(kUnitRadianceDepth, radiance_depth.id());
+  glBindSampler(kUnitRadianceDepth, shadow.id());
+  glBindVertexArray(mesh_vao.id());
+  glDrawElements(GL_TRIANGLES, index_count, GL_UNSIGNED_INT, nullptr);
+}
+
+std::vector<float> RadianceMapRenderer::Impl::read_rgba() const {
+  std::vector<float> rgba(std::size_t(final_width) * final_height * 4);
+  glGetTextureImage(final_color.id(), 0, GL_RGBA, GL_FLOAT, GLsizei(rgba.size() * sizeof(float)),
+                    rgba.data());
+  return rgba;
+}
+
+void RadianceMapRenderer::Impl::record_convergence() {
+  const std::vector<float> rgba = read_rgba();
+  std::size_t object = 0, uncovered = 0;
+  for (std::size_t i = 0; i < rgba.size(); i += 4) {
+    object += rgba[i + 3] > 0;
+    uncovered += rgba[i + 3] > 0 && rgba[i + 3] < 1;
+  }
+  stats.uncovered_fraction = object > 0 ? double(uncovered) / double(object) : 0.0;
+  if (!last_image.empty()) {
+    double diff = 0, norm = 0;
+    for (std::size_t i = 0; i < rgba.size(); i += 4) {
+      if (!(rgba[i + 3] > 0)) continue;
+      for (int c = 0; c < 3; ++c) {
+        const double d = double(rgba[i + std::size_t(c)]) - last_image[i + std::size_t(c)];
+        diff += d * d;
+        norm += double(rgba[i + std::size_t(c)]) * rgba[i + std::size_t(c)];
+      }
+    }
+    const double change = norm > 0 ? std::sqrt(diff / norm) : 0.0;
+    stats.frame_change.push_back(change);
+    if (stats.convergence_frame == 0 && change < options.convergence_tolerance) {
+      stats.convergence_frame = frame;
+    }
+  }
+  last_image = rgba;
+}
+
+void RadianceMapRenderer::set_camera(const Camera& camera) {
+  if (camera.width != impl_->final_width || camera.height != impl_->final_height) {
+    impl_->scene.camera = camera;
+    impl_->build_final();
+  }
+  impl_->scene.camera = camera;
+}
+
+void RadianceMapRenderer::set_lights(const std::vector<Light>& lights) {
+  if (lights.empty() || int(lights.size()) > kMaxLights) {
+    throw Error("--light: the radiance maps take 1 to " + std::to_string(kMaxLights) + " lights");
+  }
+  const bool resize = int(lights.size()) != impl_->L;
+  impl_->scene.lights = lights;
+  impl_->L = int(lights.size());
+  if (resize) impl_->build_light_maps();
+  impl_->upload_lights();
+  restart();
+}
+
+void RadianceMapRenderer::set_material(const materials::Material& material) {
+  impl_->scene.material = material;
+  impl_->upload_material();
+  restart();
+}
+
+void RadianceMapRenderer::restart() {
+  Impl& m = *impl_;
+  m.frame = 0;
+  m.level = 0;
+  m.light_map_valid = false;
+  m.last_image.clear();
+  const std::string renderer = m.stats.gl_renderer;
+  const double setup = m.stats.setup_ms;
+  const RadianceMapStats disc_stats = m.stats;
+  m.stats = RadianceMapStats{};
+  m.stats.gl_renderer = renderer;
+  m.stats.setup_ms = setup;
+  m.stats.sigma_star_per_mm = disc_stats.sigma_star_per_mm;
+  m.stats.disc_radius_mm = disc_stats.disc_radius_mm;
+  m.stats.used_disc_radius_mm = disc_stats.used_disc_radius_mm;
+  m.stats.samples_per_light = disc_stats.samples_per_light;
+}
+
+bool RadianceMapRenderer::render_frame() {
+  Impl& m = *impl_;
+  if (!m.light_map_valid) {
+    m.timed(kLightMap, [&] { m.render_light_map(); });
+    m.light_map_valid = true;
+    ++m.stats.light_map_renders;
+  }
+  const bool accumulate = m.frame < m.settings.frames;
+  if (accumulate) {
+    ++m.frame;
+    m.timed(kRadianceMap, [&] { m.render_radiance(); });
+    m.level = detail::blur_level_for_frame(m.frame, m.settings.frames,
+                                           std::min(m.options.max_blur_level, m.levels - 1));
+    m.timed(kMipBlur, [&] { m.render_blur(); });
+    m.stats.frames = m.frame;
+  }
+  m.timed(kFinal, [&] { m.render_final(); });
+  ++m.stats.frames_rendered;
+  if (accumulate && m.options.convergence_tolerance > 0) m.record_convergence();
+  gl::check_errors("a radiance-map frame");
+  return accumulate;
+}
+
+int RadianceMapRenderer::accumulated_frames() const {
+  return impl_->frame;
+}
+
+bool RadianceMapRenderer::converged() const {
+  return impl_->frame >= impl_->settings.frames;
+}
+
+ImageRgb RadianceMapRenderer::read_image() const {
+  const Impl& m = *impl_;
+  const std::vector<float> rgba = m.read_rgba();
+  ImageRgb image(m.final_width, m.final_height);
+  for (int y = 0; y < m.final_height; ++y) {
+    const int row = m.final_height - 1 - y;  // GL rows go up from the bottom
+    for (int x = 0; x < m.final_width; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        image.at(x, y, c) = rgba[(std::size_t(row) * m.final_width + x) * 4 + std::size_t(c)];
+      }
+    }
+  }
+  return image;
+}
+
+std::vector<std::uint8_t> RadianceMapRenderer::read_mask() const {
+  const Impl& m = *impl_;
+  const std::vector<float> rgba = m.read_rgba();
+  std::vector<std::uint8_t> mask(std::size_t(m.final_width) * m.final_height);
+  for (int y = 0; y < m.final_height; ++y) {
+    const int row = m.final_height - 1 - y;
+    for (int x = 0; x < m.final_width; ++x) {
+      mask[std::size_t(y) * m.final_width + x] =
+          rgba[(std::size_t(row) * m.final_width + x) * 4 + 3] > 0 ? 1 : 0;
+    }
+  }
+  return mask;
+}
+
+void RadianceMapRenderer::present(float exposure, int width, int height) const {
+  const Impl& m = *impl_;
+  glViewport(0, 0, width, height);
+  glDisable(GL_DEPTH_TEST);
+  m.present_program.use();
+  glUniform1f(m.present_program.location("u_exposure"), exposure);
+  glBindTextureUnit(0, m.final_color.id());
+  glBindSampler(0, m.linear_clamp.id());
+  glBindVertexArray(m.empty_vao.id());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+const RadianceMapStats& RadianceMapRenderer::stats() const {
+  return impl_->stats;
+}
+
+ImageRgb render_radiance_maps(const Scene& scene, const RenderSettings& settings,
+                              RenderStats* stats) {
+  return render_radiance_maps(scene, settings, RadianceMapOptions{}, stats, nullptr);
+}
+
+ImageRgb render_radiance_maps(const Scene& scene, const RenderSettings& settings,
+                              const RadianceMapOptions& options, RenderStats* stats,
+                              RadianceMapStats* details) {
+  const double t0 = now_ms();
+  const auto context = GlContext::create_headless();
+  RadianceMapRenderer renderer;
+  renderer.setup(scene, settings, options);
+  while (renderer.render_frame()) {
+  }
+  ImageRgb image = renderer.read_image();
+  const RadianceMapStats& s = renderer.stats();
+  if (details != nullptr) *details = s;
+  if (stats != nullptr) {
+    const StageTimes wall = s.mean_wall(), gpu = s.mean_gpu();
+    stats->technique = "maps";
+    stats->width = scene.camera.width;
+    stats->height = scene.camera.height;
+    stats->total_ms = now_ms() - t0;
+    stats->pass_ms = {{"setup", s.setup_ms},
+                      {"light map", wall.light_map_ms},
+                      {"radiance map", wall.radiance_map_ms},
+                      {"mip blur", wall.mip_blur_ms},
+                      {"final", wall.final_ms}};
+    stats->details = {
+        {"gl_renderer", s.gl_renderer},
+        {"timing", options.time_stages ? "per-frame means, glFinish + wall clock"
+                                       : "per-frame means, wall clock without glFinish"},
+        {"gpu_query_ms",
+         {{"light map", gpu.light_map_ms},
+          {"radiance map", gpu.radiance_map_ms},
+          {"mip blur", gpu.mip_blur_ms},
+          {"final", gpu.final_ms}}},
+        {"frames", s.frames},
+        {"convergence_frame", s.convergence_frame},
+        {"convergence_tolerance", options.convergence_tolerance},
+        {"frame_change", s.frame_change},
+        {"uncovered_fraction", s.uncovered_fraction},
+        {"sigma_star_per_mm", s.sigma_star_per_mm},
+        {"disc_radius_mm", s.disc_radius_mm},
+        {"used_disc_radius_mm", s.used_disc_radius_mm},
+        {"samples_per_light", s.samples_per_light},
+        {"settings", settings.to_string()},
+        {"options", options.to_string()}};
+  }
+  return image;
+}
+
+}  // namespace lucent::render

@@ -1,0 +1,195 @@
+// Halton points, the biased disc and the fitted cameras of the radiance-map technique
+// (radiance_maps_sampling.h).
+#include "radiance_maps_sampling.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <sstream>
+
+#include <Eigen/Geometry>
+
+#include "lucent/materials/error.h"
+
+namespace lucent::render::detail {
+
+double radical_inverse(unsigned index, unsigned base) {
+  double result = 0, scale = 1.0 / base;
+  for (unsigned n = index; n > 0; n /= base, scale /= base) result += (n % base) * scale;
+  return result;
+}
+
+std::vector<Vec3f> halton_sphere_directions(int count) {
+  std::vector<Vec3f> out;
+  for (int n = 1; n <= count; ++n) {
+    const double s = radical_inverse(unsigned(n), 2), t = radical_inverse(unsigned(n), 3);
+    const double z = 2 * t - 1, rho = std::sqrt(std::max(0.0, 1 - z * z));
+    const double phi = 2 * std::numbers::pi * s;
+    out.emplace_back(float(rho * std::cos(phi)), float(rho * std::sin(phi)), float(z));
+  }
+  return out;
+}
+
+double sigma_star(const materials::Material& material, double q) {
+  double lowest = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < 3; ++c) {
+    const double tr = materials::derive_coefficients(material.medium(c)).sigma_tr;
+    if (tr > 0) lowest = std::min(lowest, tr);
+  }
+  return std::isfinite(lowest) ? lowest / q : 0.0;
+}
+
+std::string DiscSamples::to_string() const {
+  std::ostringstream s;
+  s << "DiscSamples{N=" << samples.size() << ", lights=" << light_count.size()
+    << ", sigma*=" << sigma_star_per_mm << "/mm, R=" << disc_radius_mm
+    << "mm, rho=" << used_radius_mm << "mm, candidates=" << candidates << "}";
+  return s.str();
+}
+
+Eigen::Vector3d frame_shift(int t) {
+  const double phi = 1.3247179572447460;  // plastic number: x^3 = x + 1
+  const Eigen::Vector3d a(1 / phi, 1 / (phi * phi), 1 / (phi * phi * phi));
+  Eigen::Vector3d s = double(t - 1) * a;
+  for (int k = 0; k < 3; ++k) s[k] -= std::floor(s[k]);
+  return s;
+}
+
+DiscSamples exponential_disc_samples(int M, int N, double sigma_star_per_mm, double disc_radius_mm,
+                                     int lights, const Eigen::Vector3d& shift) {
+  if (M < 1 || N < 1 || N > M) {
+    throw Error("--samples/--disc-points: need 1 <= N <= M, got N=" + std::to_string(N) +
+                ", M=" + std::to_string(M));
+  }
+  if (lights < 1) throw Error("radiance maps: the scene has no lights");
+  DiscSamples out;
+  out.sigma_star_per_mm = sigma_star_per_mm;
+  double R = disc_radius_mm;
+  if (sigma_star_per_mm > 0) R = std::min(R, 30.0 / sigma_star_per_mm);
+  out.disc_radius_mm = R;
+
+  struct Point {
+    double x, y, r;
+  };
+  std::vector<Point> kept;
+  kept.reserve(std::size_t(M));
+  for (unsigned n = 1; int(kept.size()) < M; ++n) {
+    const auto wrap = [](double v) { return v - std::floor(v); };
+    const double s = wrap(radical_inverse(n, 2) + shift[0]),
+                 t = wrap(radical_inverse(n, 3) + shift[1]),
+                 zeta = wrap(radical_inverse(n, 5) + shift[2]);
+    const double r = R * std::sqrt(t);
+    ++out.candidates;
+    if (zeta < std::exp(-sigma_star_per_mm * r)) {
+      const double phi = 2 * std::numbers::pi * s;
+      kept.push_back({r * std::cos(phi), r * std::sin(phi), r});
+    }
+  }
+  std::stable_sort(kept.begin(), kept.end(),
+                   [](const Point& a, const Point& b) { return a.r < b.r; });
+  out.used_radius_mm = N < M ? 0.5 * (kept[std::size_t(N) - 1].r + kept[std::size_t(N)].r) : R;
+  // Z(rho) = integral over the disc of radius rho of e^(-sigma* r) dA
+  //        = 2 pi / sigma*^2 (1 - e^(-sigma* rho) (1 + sigma* rho)), pi rho^2 for sigma* = 0.
+  const double sigma = sigma_star_per_mm, rho = out.used_radius_mm;
+  const double Z =
+      sigma > 0 ? 2 * std::numbers::pi / (sigma * sigma) * -std::expm1(-sigma * rho) -
+                      2 * std::numbers::pi / (sigma * sigma) * std::exp(-sigma * rho) * sigma * rho
+                : std::numbers::pi * rho * rho;
+
+  // Round-robin over the radius-sorted points gives every light the same spread of radii.
+  const int L = std::min(lights, N);
+  for (int l = 0; l < lights; ++l) {
+    out.light_offset.push_back(int(out.samples.size()));
+    int count = 0;
+    for (int i = l % L; i < N; i += L) ++count;
+    for (int i = l % L; i < N; i += L) {
+      const Point& p = kept[std::size_t(i)];
+      out.samples.push_back({float(p.x), float(p.y), float(Z * std::exp(sigma * p.r) / count)});
+    }
+    out.light_count.push_back(int(out.samples.size()) - out.light_offset.back());
+  }
+  return out;
+}
+
+namespace {
+
+Mat4f look_at(const Vec3f& eye, const Vec3f& target, Vec3f up) {
+  const Vec3f f = (target - eye).normalized();
+  if (std::abs(f.dot(up.normalized())) > 0.999f)
+    up = std::abs(f.x()) < 0.9f ? Vec3f::UnitX() : Vec3f::UnitY();
+  const Vec3f s = f.cross(up).normalized();
+  const Vec3f u = s.cross(f);
+  Mat4f m = Mat4f::Identity();
+  m.row(0) << s.transpose(), -s.dot(eye);
+  m.row(1) << u.transpose(), -u.dot(eye);
+  m.row(2) << -f.transpose(), f.dot(eye);
+  return m;
+}
+
+Mat4f orthographic(float half_extent, float near_mm, float far_mm) {
+  Mat4f m = Mat4f::Identity();
+  m(0, 0) = 1 / half_extent;
+  m(1, 1) = 1 / half_extent;
+  m(2, 2) = -2 / (far_mm - near_mm);
+  m(2, 3) = -(far_mm + near_mm) / (far_mm - near_mm);
+  return m;
+}
+
+Mat4f perspective(float fov_y_rad, float aspect, float near_mm, float far_mm) {
+  const float f = 1 / std::tan(fov_y_rad / 2);
+  Mat4f m = Mat4f::Zero();
+  m(0, 0) = f / aspect;
+  m(1, 1) = f;
+  m(2, 2) = (far_mm + near_mm) / (near_mm - far_mm);
+  m(2, 3) = 2 * far_mm * near_mm / (near_mm - far_mm);
+  m(3, 2) = -1;
+  return m;
+}
+
+}  // namespace
+
+LayerCamera fitted_orthographic(const Vec3f& centre, float radius_mm, const Vec3f& toward_camera) {
+  LayerCamera c;
+  c.direction = toward_camera.normalized();
+  const float r = radius_mm * 1.02f;  // a texel of margin around the silhouette
+  const Vec3f eye = centre + 2 * r * c.direction;
+  c.near_mm = r;
+  c.far_mm = 3 * r;
+  c.extent_mm = 2 * r;
+  c.view_proj = orthographic(r, c.near_mm, c.far_mm) * look_at(eye, centre, Vec3f::UnitY());
+  return c;
+}
+
+LayerCamera fitted_perspective(const Vec3f& centre, float radius_mm, const Vec3f& eye) {
+  LayerCamera c;
+  const float r = radius_mm * 1.02f;
+  const float distance = (eye - centre).norm();
+  c.direction = distance > 0 ? Vec3f((eye - centre) / distance) : Vec3f::UnitZ();
+  const float half_angle =
+      distance > 1.05f * r ? std::asin(r / distance) : 75.0f * std::numbers::pi_v<float> / 180.0f;
+  c.near_mm = std::max(distance - r, 1e-3f * std::max(distance, r));
+  c.far_mm = distance + r;
+  const Vec3f target = distance > 0 ? centre : Vec3f(eye - Vec3f::UnitZ());
+  c.view_proj =
+      perspective(2 * half_angle, 1.0f, c.near_mm, c.far_mm) * look_at(eye, target, Vec3f::UnitY());
+  return c;
+}
+
+Mat4f camera_view_proj(const Camera& camera, const Vec3f& centre, float radius_mm) {
+  const float distance = (camera.eye - centre).norm();
+  const float r = radius_mm * 1.05f;
+  const float near_mm = std::max(distance - r, 1e-3f * std::max(distance, r));
+  const float far_mm = distance + r;
+  return perspective(camera.fov_y_deg * std::numbers::pi_v<float> / 180.0f,
+                     float(camera.width) / float(camera.height), near_mm, far_mm) *
+         look_at(camera.eye, camera.target, camera.up);
+}
+
+int blur_level_for_frame(int t, int T, int max_level) {
+  if (t >= T || max_level <= 0) return 0;
+  const double level = std::ceil(0.5 * std::log2(double(T) / std::max(t, 1)) - 1e-9);
+  return std::clamp(int(level), 0, max_level);
+}
+
+}  // namespace lucent::render::detail

@@ -1,0 +1,718 @@
+// The CPU reference renderer (reference_renderer.h; DESIGN §7.5).
+#include "lucent/render/reference_renderer.h"
+
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <numbers>
+#include <thread>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include "lucent/materials/dipole.h"
+#include "lucent/materials/directional_dipole.h"
+#include "lucent/materials/error.h"
+#include "lucent/materials/fresnel.h"
+#include "lucent/render/environment.h"
+
+namespace lucent::render {
+namespace {
+
+using Vec3d = Eigen::Vector3d;
+using Clock = std::chrono::steady_clock;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Threads: work items handed out in chunks from an atomic counter; results never depend on which
+// thread ran what.
+
+void parallel_for(std::size_t count, int threads, std::size_t chunk,
+                  const std::function<void(std::size_t, std::size_t)>& body,
+                  const std::function<void(std::size_t)>& on_progress = {}) {
+  std::atomic<std::size_t> next{0}, done{0};
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  const auto work = [&](bool reporter) {
+    try {
+      for (;;) {
+        const std::size_t begin = next.fetch_add(chunk);
+        if (begin >= count) break;
+        const std::size_t end = std::min(count, begin + chunk);
+        body(begin, end);
+        const std::size_t total = done.fetch_add(end - begin) + (end - begin);
+        if (reporter && on_progress) on_progress(total);
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(failure_mutex);
+      if (!failure) failure = std::current_exception();
+      next = count;
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work, false);
+  work(true);
+  for (auto& thread : pool) thread.join();
+  if (failure) std::rethrow_exception(failure);
+}
+
+// Counter-based random numbers: sample k of pass p of seed s is the same whatever thread draws it.
+std::uint64_t mix(std::uint64_t z) {
+  z += 0x9E3779B97F4A7C15ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+double uniform01(std::uint64_t key) {
+  return double(mix(key) >> 11) * 0x1.0p-53;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Embree scene of the mesh.
+
+class RayScene {
+ public:
+  explicit RayScene(const Mesh& mesh) {
+    device_ = rtcNewDevice("verbose=0");
+    if (!device_) throw Error("reference renderer: cannot create an Embree device");
+    scene_ = rtcNewScene(device_);
+    RTCGeometry geometry = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vertices = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                3 * sizeof(float), mesh.positions.size()));
+    for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+      for (int k = 0; k < 3; ++k) vertices[3 * i + k] = mesh.positions[i][k];
+    }
+    auto* indices = static_cast<unsigned*>(
+        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                3 * sizeof(unsigned), mesh.triangles.size()));
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      for (int k = 0; k < 3; ++k) indices[3 * t + k] = mesh.triangles[t][k];
+    }
+    rtcCommitGeometry(geometry);
+    rtcAttachGeometry(scene_, geometry);
+    rtcReleaseGeometry(geometry);
+    rtcCommitScene(scene_);
+  }
+  ~RayScene() {
+    rtcReleaseScene(scene_);
+    rtcReleaseDevice(device_);
+  }
+  RayScene(const RayScene&) = delete;
+  RayScene& operator=(const RayScene&) = delete;
+
+  /// Nearest hit: triangle index and Embree's barycentrics (u, v) of vertices 1 and 2; false if
+  /// none.
+  bool intersect(const Vec3f& origin, const Vec3f& direction, unsigned& triangle, float& u,
+                 float& v) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRayHit rh{};
+    set_ray(rh.ray, origin, direction, kInf);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(scene_, &context, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    triangle = rh.hit.primID;
+    u = rh.hit.u;
+    v = rh.hit.v;
+    return true;
+  }
+
+  bool occluded(const Vec3f& origin, const Vec3f& direction, double max_distance) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRay ray{};
+    set_ray(ray, origin, direction, max_distance);
+    rtcOccluded1(scene_, &context, &ray);
+    return ray.tfar < 0;  // Embree sets tfar = -inf on a hit
+  }
+
+ private:
+  static void set_ray(RTCRay& ray, const Vec3f& o, const Vec3f& d, double tfar) {
+    ray.org_x = o.x();
+    ray.org_y = o.y();
+    ray.org_z = o.z();
+    ray.dir_x = d.x();
+    ray.dir_y = d.y();
+    ray.dir_z = d.z();
+    ray.tnear = 0.0f;
+    ray.tfar = std::isinf(tfar) ? std::numeric_limits<float>::infinity() : float(tfar);
+    ray.mask = ~0u;
+    ray.flags = 0;
+    ray.time = 0.0f;
+  }
+
+  RTCDevice device_ = nullptr;
+  RTCScene scene_ = nullptr;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Irradiance records and their cluster hierarchy.
+
+/// One surface sample lit by one light (directional dipole) or by all of them (standard dipole):
+/// E already holds (A / N) * radiance * cos * V * F_t per channel.
+struct Record {
+  Vec3f x;  ///< mm
+  Vec3f n;  ///< unit shading normal
+  Vec3f w;  ///< unit direction toward the light (directional dipole only)
+  std::array<float, 3> E;
+};
+
+struct ClusterNode {
+  Vec3f centre;                       ///< of the bounding box of the node's samples
+  float radius = 0;                   ///< bounding sphere about `centre`, mm
+  std::uint32_t begin = 0, end = 0;   ///< record range
+  std::uint32_t left = 0, right = 0;  ///< children; 0 for a leaf (the root is never a child)
+  // Cluster summary (inner nodes only): per channel the total E, the E-weighted centroid and the
+  // two sigma-point offsets sqrt(2 lambda_k) e_k; the E-weighted mean normal and light direction,
+  // whose lengths measure how much the node's normals (directions) agree.
+  std::array<float, 3> E{};
+  std::array<Vec3f, 3> centroid;
+  std::array<std::array<Vec3f, 2>, 3> axis;
+  Vec3f mean_n = Vec3f::Zero();
+  Vec3f mean_w = Vec3f::Zero();
+};
+
+class ClusterTree {
+ public:
+  static constexpr std::uint32_t kLeafSize = 4;
+
+  explicit ClusterTree(std::vector<Record> records) : records_(std::move(records)) {
+    if (records_.empty()) return;
+    nodes_.reserve(2 * records_.size() / kLeafSize + 1);
+    build(0, std::uint32_t(records_.size()));
+  }
+
+  const std::vector<Record>& records() const { return records_; }
+  const std::vector<ClusterNode>& nodes() const { return nodes_; }
+  bool empty() const { return records_.empty(); }
+
+ private:
+  std::uint32_t build(std::uint32_t begin, std::uint32_t end) {
+    const std::uint32_t index = std::uint32_t(nodes_.size());
+    nodes_.emplace_back();
+    Eigen::AlignedBox3f box;
+    for (std::uint32_t i = begin; i < end; ++i) box.extend(records_[i].x);
+    ClusterNode node;
+    node.centre = box.center();
+    for (std::uint32_t i = begin; i < end; ++i) {
+      node.radius = std::max(node.radius, (records_[i].x - node.centre).norm());
+    }
+    node.begin = begin;
+    node.end = end;
+    if (end - begin > kLeafSize) {
+      summarise(node);
+      int axis = 0;
+      box.sizes().maxCoeff(&axis);
+      const std::uint32_t mid = begin + (end - begin) / 2;
+      std::nth_element(records_.begin() + begin, records_.begin() + mid, records_.begin() + end,
+                       [axis](const Record& a, const Record& b) { return a.x[axis] < b.x[axis]; });
+      node.left = build(begin, mid);
+      node.right = build(mid, end);
+    }
+    nodes_[index] = node;
+    return index;
+  }
+
+  void summarise(ClusterNode& node) const {
+    double weight_all = 0;
+    Vec3d n_sum = Vec3d::Zero(), w_sum = Vec3d::Zero();
+    const Vec3d origin = node.centre.cast<double>();  // moments about the centre, for precision
+    for (int c = 0; c < 3; ++c) {
+      double W = 0;
+      Vec3d first = Vec3d::Zero();
+      Eigen::Matrix3d second = Eigen::Matrix3d::Zero();
+      for (std::uint32_t i = node.begin; i < node.end; ++i) {
+        const Record& r = records_[i];
+        const double e = r.E[c];
+        const Vec3d y = r.x.cast<double>() - origin;
+        W += e;
+        first += e * y;
+        second += e * y * y.transpose();
+      }
+      node.E[c] = float(W);
+      if (!(W > 0)) {
+        node.centroid[c] = node.centre;
+        node.axis[c] = {Vec3f::Zero(), Vec3f::Zero()};
+        continue;
+      }
+      const Vec3d mean = first / W;
+      const Eigen::Matrix3d covariance = second / W - mean * mean.transpose();
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+      eigen.computeDirect(covariance);
+      node.centroid[c] = (origin + mean).cast<float>();
+      // Eigenvalues ascending: the two largest span the (locally flat) surface patch.
+      for (int k = 0; k < 2; ++k) {
+        const double lambda = std::max(0.0, eigen.eigenvalues()[2 - k]);
+        node.axis[c][k] = (std::sqrt(2 * lambda) * eigen.eigenvectors().col(2 - k)).cast<float>();
+      }
+    }
+    for (std::uint32_t i = node.begin; i < node.end; ++i) {
+      const Record& r = records_[i];
+      const double e = double(r.E[0]) + r.E[1] + r.E[2];
+      weight_all += e;
+      n_sum += e * r.n.cast<double>();
+      w_sum += e * r.w.cast<double>();
+    }
+    if (weight_all > 0) {
+      node.mean_n = (n_sum / weight_all).cast<float>();
+      node.mean_w = (w_sum / weight_all).cast<float>();
+    }
+  }
+
+  std::vector<Record> records_;
+  std::vector<ClusterNode> nodes_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// The BSSRDF per channel, in double.
+
+class ChannelBssrdf {
+ public:
+  ChannelBssrdf(const materials::Medium<double>& medium, DiffusionModel model)
+      : model_(model), dipole_(medium), ddipole_(medium) {}
+
+  /// S_d per mm^2 per sr without Fresnel; n_i and w_i are ignored by the standard dipole.
+  double operator()(const Vec3d& x_i, const Vec3d& n_i, const Vec3d& w_i, const Vec3d& x_o,
+                    const Vec3d& n_o) const {
+    if (model_ == DiffusionModel::kDipole) return dipole_.S_d((x_o - x_i).norm());
+    return ddipole_.S_d(x_i, n_i, w_i, x_o, n_o);
+  }
+
+ private:
+  DiffusionModel model_;
+  materials::StandardDipole<double> dipole_;
+  materials::DirectionalDipole<double> ddipole_;
+};
+
+struct GatherCounters {
+  std::uint64_t exact = 0;    ///< S_d evaluations for single samples (per channel)
+  std::uint64_t cluster = 0;  ///< S_d evaluations at sigma points (per channel)
+};
+
+/// sum over the tree's records of E_c S_d,c(x_i, n_i, w_i, x_o, n_o), per channel.
+std::array<double, 3> gather(const ClusterTree& tree, const std::array<ChannelBssrdf, 3>& bssrdf,
+                             const std::array<double, 3>& r_cut, double cluster_ratio,
+                             bool needs_coherence, bool point_light, const Vec3f& x_o_f,
+                             const Vec3f& n_o_f, GatherCounters& counters) {
+  std::array<double, 3> sum{0, 0, 0};
+  if (tree.empty()) return sum;
+  const Vec3d x_o = x_o_f.cast<double>(), n_o = n_o_f.cast<double>();
+  const double r_cut_max = std::max({r_cut[0], r_cut[1], r_cut[2]});
+  const auto& nodes = tree.nodes();
+  const auto& records = tree.records();
+  std::uint32_t stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const ClusterNode& node = nodes[stack[--top]];
+    const double d = (x_o_f - node.centre).norm();
+    if (d - node.radius > r_cut_max) continue;
+    if (node.left == 0) {
+      for (std::uint32_t i = node.begin; i < node.end; ++i) {
+        const Record& r = records[i];
+        const Vec3d x_i = r.x.cast<double>();
+        const double dist = (x_o - x_i).norm();
+        const Vec3d n_i = r.n.cast<double>(), w_i = r.w.cast<double>();
+        for (int c = 0; c < 3; ++c) {
+          if (r.E[c] > 0 && dist <= r_cut[c]) {
+            sum[c] += double(r.E[c]) * bssrdf[c](x_i, n_i, w_i, x_o, n_o);
+            ++counters.exact;
+          }
+        }
+      }
+      continue;
+    }
+    bool accept = cluster_ratio > 0 && node.radius < cluster_ratio * d;
+    if (accept && needs_coherence) {
+      accept = node.mean_n.norm() >= 0.9f && (!point_light || node.mean_w.norm() >= 0.99f);
+    }
+    if (accept) {
+      const Vec3d n_i = node.mean_n.cast<double>().normalized();
+      const Vec3d w_i = node.mean_w.cast<double>().normalized();
+      for (int c = 0; c < 3; ++c) {
+        if (!(node.E[c] > 0) || d - node.radius > r_cut[c]) continue;
+        const Vec3d centroid = node.centroid[c].cast<double>();
+        double s = 0;
+        for (int k = 0; k < 2; ++k) {
+          const Vec3d a = node.axis[c][k].cast<double>();
+          s += bssrdf[c](centroid + a, n_i, w_i, x_o, n_o) +
+               bssrdf[c](centroid - a, n_i, w_i, x_o, n_o);
+        }
+        sum[c] += double(node.E[c]) * 0.25 * s;
+        counters.cluster += 4;
+      }
+      continue;
+    }
+    // A fixed order (left first): the sum, rounding included, is the same on every run.
+    stack[top++] = node.right;
+    stack[top++] = node.left;
+  }
+  return sum;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Surface samples.
+
+struct SurfaceSampler {
+  explicit SurfaceSampler(const Mesh& mesh) : mesh_(mesh) {
+    cdf_.resize(mesh.triangles.size() + 1, 0.0);
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const auto& tri = mesh.triangles[t];
+      const Vec3d a = mesh.positions[tri[0]].cast<double>(),
+                  b = mesh.positions[tri[1]].cast<double>(),
+                  c = mesh.positions[tri[2]].cast<double>();
+      cdf_[t + 1] = cdf_[t] + 0.5 * (b - a).cross(c - a).norm();
+    }
+  }
+  double area() const { return cdf_.back(); }
+
+  /// Sample k of n: stratum k of the area CDF (jittered by xi1), uniform within its triangle.
+  void sample(std::size_t k, std::size_t n, double xi1, double xi2, Vec3f& x, Vec3f& normal,
+              Vec3f& geometric_normal) const {
+    const double target = (double(k) + xi1) / double(n) * area();
+    auto it = std::upper_bound(cdf_.begin() + 1, cdf_.end() - 1, target);
+    std::size_t t = std::size_t(it - cdf_.begin()) - 1;
+    while (t > 0 && !(cdf_[t + 1] > cdf_[t])) --t;
+    const double width = cdf_[t + 1] - cdf_[t];
+    const double s = std::sqrt(width > 0 ? std::clamp((target - cdf_[t]) / width, 0.0, 1.0) : 0.5);
+    const double b1 = s * (1 - xi2), b2 = s * xi2, b0 = 1 - b1 - b2;
+    const auto& tri = mesh_.triangles[t];
+    const Vec3f &p0 = mesh_.positions[tri[0]], &p1 = mesh_.positions[tri[1]],
+                &p2 = mesh_.positions[tri[2]];
+    x = (b0 * p0.cast<double>() + b1 * p1.cast<double>() + b2 * p2.cast<double>()).cast<float>();
+    normal = (float(b0) * mesh_.normals[tri[0]] + float(b1) * mesh_.normals[tri[1]] +
+              float(b2) * mesh_.normals[tri[2]])
+                 .normalized();
+    geometric_normal = (p1 - p0).cross(p2 - p0).normalized();
+  }
+
+ private:
+  const Mesh& mesh_;
+  std::vector<double> cdf_;
+};
+
+struct PixelHit {
+  Vec3f x_o, n_o;
+  double fresnel_out = 0;  ///< F_t(eta, n_o . w_o)
+  double fresnel_reflect = 0;
+  Vec3f reflected = Vec3f::Zero();
+};
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+double subsurface_cutoff_mm(const materials::Medium<double>& medium, DiffusionModel model,
+                            double tolerance) {
+  const auto c = materials::derive_coefficients(medium);
+  if (!c.scatters() || !(c.sigma_tr > 0)) return kInf;
+  const ChannelBssrdf bssrdf(medium, model);
+  // Normal incidence on the plane z = 0: profile(r) = S_d(0, z, z, (r, 0, 0), z), integrated with
+  // weight 2 pi r dr on a log grid (trapezoid in ln r) from far inside a mean free path to 60
+  // diffusion lengths, where e^(-60) leaves nothing.
+  const double mfp = 1.0 / c.sigma_t_reduced;
+  const double r_lo = 1e-6 * mfp, r_hi = std::max(60.0 / c.sigma_tr, 1e3 * mfp);
+  const int n = 6000;
+  const Vec3d z(0, 0, 1);
+  std::vector<double> r(n), cumulative(n, 0.0);
+  double previous = 0;
+  for (int i = 0; i < n; ++i) {
+    r[i] = r_lo * std::pow(r_hi / r_lo, double(i) / (n - 1));
+    const double f = bssrdf(Vec3d::Zero(), z, z, Vec3d(r[i], 0, 0), z) * r[i] * r[i];
+    if (i > 0) cumulative[i] = cumulative[i - 1] + 0.5 * (f + previous) * std::log(r[i] / r[i - 1]);
+    previous = f;
+  }
+  const double total = cumulative.back();
+  if (!(total > 0)) return kInf;
+  for (int i = 0; i < n; ++i) {
+    if (total - cumulative[i] <= tolerance * total) {
+      return r[i] >= 0.99 * r_hi ? kInf : r[i];
+    }
+  }
+  return kInf;
+}
+
+double masked_rmse(const ImageRgb& a, const ImageRgb& b, const std::vector<std::uint8_t>& mask) {
+  if (a.width != b.width || a.height != b.height) {
+    throw Error("masked_rmse: images differ in size");
+  }
+  double sum = 0;
+  std::size_t count = 0;
+  for (std::size_t p = 0; p < mask.size(); ++p) {
+    if (!mask[p]) continue;
+    for (int c = 0; c < 3; ++c) {
+      const double d = double(a.data[3 * p + c]) - b.data[3 * p + c];
+      sum += d * d;
+      ++count;
+    }
+  }
+  return count ? std::sqrt(sum / count) : 0.0;
+}
+
+double masked_mean(const ImageRgb& image, const std::vector<std::uint8_t>& mask) {
+  double sum = 0;
+  std::size_t count = 0;
+  for (std::size_t p = 0; p < mask.size(); ++p) {
+    if (!mask[p]) continue;
+    for (int c = 0; c < 3; ++c) sum += image.data[3 * p + c];
+    count += 3;
+  }
+  return count ? sum / count : 0.0;
+}
+
+ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
+                                const ReferenceOptions& options) {
+  const auto start = Clock::now();
+  const Camera& camera = scene.camera;
+  const Mesh& mesh = scene.mesh;
+  if (camera.width <= 0 || camera.height <= 0) {
+    throw Error("reference renderer: the image must be at least 1x1 pixels, got " +
+                std::to_string(camera.width) + "x" + std::to_string(camera.height));
+  }
+  if (options.surface_samples < 1) {
+    throw Error("--samples-reference: must be at least 1, got " +
+                std::to_string(options.surface_samples));
+  }
+  if (options.passes < 1) throw Error("reference renderer: passes must be at least 1");
+  if (mesh.triangles.empty() || mesh.normals.size() != mesh.positions.size()) {
+    throw Error("reference renderer: mesh '" + mesh.name + "' has no triangles or no normals");
+  }
+  const int threads =
+      options.threads > 0 ? options.threads : std::max(1, int(std::thread::hardware_concurrency()));
+  const double eta = scene.material.ior;
+  const std::array<materials::Medium<double>, 3> media = {
+      scene.material.medium(0), scene.material.medium(1), scene.material.medium(2)};
+  const std::array<ChannelBssrdf, 3> bssrdf = {ChannelBssrdf(media[0], model),
+                                               ChannelBssrdf(media[1], model),
+                                               ChannelBssrdf(media[2], model)};
+  std::array<double, 3> r_cut;
+  for (int c = 0; c < 3; ++c) r_cut[c] = subsurface_cutoff_mm(media[c], model);
+
+  std::unique_ptr<EnvironmentMap> environment;
+  if (scene.environment)
+    environment = std::make_unique<EnvironmentMap>(load_environment(*scene.environment));
+
+  const RayScene rays(mesh);
+  const float eps = 1e-4f * std::max(mesh.bounding_radius(), 1e-6f);  // ray offset, mm
+
+  // Primary rays: the camera's pixels, row 0 at the top.
+  const int W = camera.width, H = camera.height;
+  const std::size_t pixels = std::size_t(W) * H;
+  const Vec3f forward = (camera.target - camera.eye).normalized();
+  const Vec3f right = forward.cross(camera.up).normalized();
+  const Vec3f up = right.cross(forward);
+  const float tan_half = std::tan(camera.fov_y_deg * std::numbers::pi_v<float> / 360.0f);
+  const float aspect = float(W) / float(H);
+  const auto pixel_direction = [&](std::size_t p) {
+    const float sx = (2.0f * (float(p % W) + 0.5f) / W - 1.0f) * tan_half * aspect;
+    const float sy = (1.0f - 2.0f * (float(p / W) + 0.5f) / H) * tan_half;
+    return Vec3f(forward + sx * right + sy * up).normalized();
+  };
+
+  ReferenceImage result;
+  result.mask.assign(pixels, 0);
+  std::vector<PixelHit> hits(pixels);
+  ImageRgb background(W, H, 0.0f);
+  const auto primary_start = Clock::now();
+  parallel_for(pixels, threads, 256, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t p = begin; p < end; ++p) {
+      const Vec3f dir = pixel_direction(p);
+      unsigned tri = 0;
+      float u = 0, v = 0;
+      if (!rays.intersect(camera.eye, dir, tri, u, v)) {
+        if (environment) {
+          const Vec3f L = environment_lookup(*environment, dir);
+          for (int c = 0; c < 3; ++c) background.data[3 * p + c] = L[c];
+        }
+        continue;
+      }
+      const auto& t = mesh.triangles[tri];
+      const float b0 = 1 - u - v;
+      PixelHit& hit = hits[p];
+      hit.x_o = b0 * mesh.positions[t[0]] + u * mesh.positions[t[1]] + v * mesh.positions[t[2]];
+      hit.n_o =
+          (b0 * mesh.normals[t[0]] + u * mesh.normals[t[1]] + v * mesh.normals[t[2]]).normalized();
+      const Vec3f w_o = -dir;
+      const double cos_o = hit.n_o.dot(w_o);
+      hit.fresnel_out = materials::fresnel_transmittance(cos_o, eta);
+      hit.fresnel_reflect = 1.0 - hit.fresnel_out;
+      hit.reflected = (2.0f * hit.n_o.dot(w_o) * hit.n_o - w_o).normalized();
+      result.mask[p] = 1;
+    }
+  });
+  std::vector<std::uint32_t> object_pixels;
+  for (std::size_t p = 0; p < pixels; ++p) {
+    if (result.mask[p]) object_pixels.push_back(std::uint32_t(p));
+  }
+  const double primary_ms = ms_since(primary_start);
+
+  // Light groups: the standard dipole does not depend on the light's direction, so all lights
+  // share one record per sample; the directional dipole needs one record set per light.
+  const bool per_light = model == DiffusionModel::kDirectionalDipole;
+  const std::size_t groups = per_light ? scene.lights.size() : (scene.lights.empty() ? 0 : 1);
+  const std::size_t N = std::size_t(options.surface_samples);
+  const SurfaceSampler sampler(mesh);
+  const double area_per_sample = sampler.area() / double(N);
+
+  ImageRgb mean(W, H, 0.0f);
+  double sampling_ms = 0, tree_ms = 0, gather_ms = 0;
+  std::uint64_t records_total = 0, exact_total = 0, cluster_total = 0;
+  const double work_total = double(options.passes) * double(std::max<std::size_t>(groups, 1)) *
+                            double(std::max<std::size_t>(object_pixels.size(), 1));
+  std::mutex progress_mutex;
+
+  for (int pass = 0; pass < options.passes; ++pass) {
+    const auto sampling_start = Clock::now();
+    // Samples: position, shading normal, geometric normal (for the shadow-ray offset).
+    std::vector<Vec3f> xs(N), ns(N), gs(N);
+    const std::uint64_t pass_key = mix(options.seed * 0x632BE59BD9B4E019ull + std::uint64_t(pass));
+    parallel_for(N, threads, 4096, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) {
+        const std::uint64_t key = mix(pass_key ^ (std::uint64_t(k) * 2 + 1));
+        sampler.sample(k, N, uniform01(key), uniform01(key ^ 0xA5A5A5A5A5A5A5A5ull), xs[k], ns[k],
+                       gs[k]);
+      }
+    });
+    sampling_ms += ms_since(sampling_start);
+
+    // One light group at a time (its records, tree and gather), so that memory stays at one record
+    // per sample however many lights an environment map brings.
+    std::vector<std::array<double, 3>> accumulated(object_pixels.size(), {0, 0, 0});
+    for (std::size_t g = 0; g < groups; ++g) {
+      // Irradiance records: E = (A/N) radiance cos V F_t.
+      const auto records_start = Clock::now();
+      const std::size_t first_light = per_light ? g : 0;
+      const std::size_t end_light = per_light ? g + 1 : scene.lights.size();
+      std::vector<Record> records(N);
+      parallel_for(N, threads, 1024, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t k = begin; k < end; ++k) {
+          Record& r = records[k];
+          r.x = xs[k];
+          r.n = ns[k];
+          r.w = Vec3f::Zero();
+          r.E = {0, 0, 0};
+          for (std::size_t l = first_light; l < end_light; ++l) {
+            const Light& light = scene.lights[l];
+            Vec3f w;
+            double irradiance_scale = 1, distance = kInf;
+            if (light.type == LightType::kDirectional) {
+              w = light.direction.normalized();
+            } else {
+              const Vec3f to_light = light.position - xs[k];
+              distance = to_light.norm();
+              if (!(distance > 0)) continue;
+              w = to_light / float(distance);
+              irradiance_scale = 1.0 / (distance * distance);
+            }
+            const double cos_i = ns[k].dot(w);
+            if (!(cos_i > 0)) continue;
+            if (options.shadows) {
+              // Offset to the light's side of the flat triangle (the shading normal may differ).
+              const Vec3f offset = gs[k].dot(w) >= 0 ? gs[k] : Vec3f(-gs[k]);
+              if (rays.occluded(xs[k] + eps * offset, w, distance - eps)) continue;
+            }
+            const double factor = area_per_sample * irradiance_scale * cos_i *
+                                  materials::fresnel_transmittance(cos_i, eta);
+            r.w = w;
+            for (int c = 0; c < 3; ++c) r.E[c] += float(factor * light.radiance[c]);
+          }
+        }
+      });
+      sampling_ms += ms_since(records_start);
+
+      const auto tree_start = Clock::now();
+      std::erase_if(records,
+                    [](const Record& r) { return !(r.E[0] > 0 || r.E[1] > 0 || r.E[2] > 0); });
+      records_total += records.size();
+      const ClusterTree tree(std::move(records));
+      tree_ms += ms_since(tree_start);
+      const bool point_light = per_light && scene.lights[g].type == LightType::kPoint;
+
+      const auto gather_start = Clock::now();
+      std::atomic<std::uint64_t> exact{0}, cluster{0};
+      const double work_before =
+          (double(pass) * double(std::max<std::size_t>(groups, 1)) + double(g)) *
+          double(std::max<std::size_t>(object_pixels.size(), 1));
+      parallel_for(
+          object_pixels.size(), threads, 16,
+          [&](std::size_t begin, std::size_t end) {
+            GatherCounters counters;
+            for (std::size_t i = begin; i < end; ++i) {
+              const PixelHit& hit = hits[object_pixels[i]];
+              const auto s = gather(tree, bssrdf, r_cut, options.cluster_ratio, per_light,
+                                    point_light, hit.x_o, hit.n_o, counters);
+              for (int c = 0; c < 3; ++c) accumulated[i][c] += s[c];
+            }
+            exact += counters.exact;
+            cluster += counters.cluster;
+          },
+          [&](std::size_t done) {
+            if (!options.progress) return;
+            std::lock_guard<std::mutex> lock(progress_mutex);
+            options.progress(std::min(1.0, (work_before + double(done)) / work_total));
+          });
+      exact_total += exact;
+      cluster_total += cluster;
+      gather_ms += ms_since(gather_start);
+    }
+
+    // This pass's image, folded into the running mean.
+    ImageRgb image = background;
+    for (std::size_t i = 0; i < object_pixels.size(); ++i) {
+      const std::size_t p = object_pixels[i];
+      const PixelHit& hit = hits[p];
+      Vec3f reflection = Vec3f::Zero();
+      if (options.environment_reflection && environment) {
+        reflection = float(hit.fresnel_reflect) * environment_lookup(*environment, hit.reflected);
+      }
+      for (int c = 0; c < 3; ++c) {
+        image.data[3 * p + c] = float(hit.fresnel_out * accumulated[i][c]) + reflection[c];
+      }
+    }
+    const float blend = 1.0f / float(pass + 1);
+    for (std::size_t i = 0; i < mean.data.size(); ++i) {
+      mean.data[i] += blend * (image.data[i] * options.exposure - mean.data[i]);
+    }
+    result.passes.push_back(mean);
+  }
+  result.image = mean;
+
+  RenderStats& stats = result.stats;
+  stats.technique = "reference";
+  stats.width = W;
+  stats.height = H;
+  stats.pass_ms = {{"primary rays", primary_ms},
+                   {"surface samples and shadow rays", sampling_ms},
+                   {"cluster trees", tree_ms},
+                   {"gather", gather_ms}};
+  stats.total_ms = ms_since(start);
+  stats.details = {{"model", materials::to_string(model)},
+                   {"surface_samples_per_pass", options.surface_samples},
+                   {"passes", options.passes},
+                   {"lights", scene.lights.size()},
+                   {"object_pixels", object_pixels.size()},
+                   {"lit_records", records_total},
+                   {"exact_evaluations", exact_total},
+                   {"cluster_evaluations", cluster_total},
+                   {"cluster_ratio", options.cluster_ratio},
+                   {"shadows", options.shadows},
+                   {"threads", threads},
+                   {"seed", options.seed},
+                   {"cutoff_mm",
+                    {std::isinf(r_cut[0]) ? -1.0 : r_cut[0], std::isinf(r_cut[1]) ? -1.0 : r_cut[1],
+                     std::isinf(r_cut[2]) ? -1.0 : r_cut[2]}}};
+  return result;
+}
+
+}  // namespace lucent::render

@@ -1,0 +1,59 @@
+// Validation and self-description of RenderSettings and RenderStats (render_settings.h).
+#include "lucent/render/render_settings.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "lucent/materials/error.h"
+
+namespace lucent::render {
+namespace {
+
+void require(bool ok, const std::string& option, const std::string& what, double value) {
+  if (!ok) {
+    std::ostringstream s;
+    s << option << ": " << what << ", got " << value;
+    throw Error(s.str());
+  }
+}
+
+}  // namespace
+
+void RenderSettings::validate() const {
+  require(frames >= 1, "--frames", "must be at least 1", frames);
+  require(directions >= 1 && directions <= 256, "--directions", "must be 1..256", directions);
+  require(samples >= 1, "--samples", "must be at least 1", samples);
+  require(disc_points >= 1, "--disc-points", "must be at least 1", disc_points);
+  require(samples <= disc_points, "--samples",
+          "must not exceed --disc-points (" + std::to_string(disc_points) + ")", samples);
+  require(std::isfinite(q) && q > 0, "--q", "must be positive", q);
+  require(radiance_map_size >= 8 && radiance_map_size <= 8192, "--radiance-map",
+          "must be 8..8192 texels", radiance_map_size);
+  require(light_map_size >= 8 && light_map_size <= 8192, "--light-map", "must be 8..8192 texels",
+          light_map_size);
+  require(std::isfinite(exposure) && exposure > 0, "--exposure", "must be positive", exposure);
+}
+
+std::string RenderSettings::to_string() const {
+  std::ostringstream s;
+  s << "RenderSettings{model=" << materials::to_string(model) << ", T=" << frames
+    << ", K=" << directions << ", N=" << samples << ", M=" << disc_points << ", q=" << q
+    << ", W_s=" << radiance_map_size << ", W_l=" << light_map_size << ", exposure=" << exposure
+    << "}";
+  return s.str();
+}
+
+nlohmann::json RenderStats::to_json() const {
+  nlohmann::json passes = nlohmann::json::array();
+  for (const auto& [name, ms] : pass_ms) passes.push_back({{"name", name}, {"ms", ms}});
+  return {{"format", "lucent-render-stats"},
+          {"version", 1},
+          {"technique", technique},
+          {"width", width},
+          {"height", height},
+          {"total_ms", total_ms},
+          {"passes", passes},
+          {"details", details}};
+}
+
+}  // namespace lucent::render

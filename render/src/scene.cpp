@@ -1,0 +1,138 @@
+// Mesh measures, lights from the command line, the orbit camera
+// (render/include/lucent/render/scene.h).
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "lucent/materials/error.h"
+#include "lucent/render/scene.h"
+
+namespace lucent::render {
+
+Vec3f Mesh::bounds_min() const {
+  Vec3f lo = Vec3f::Constant(std::numeric_limits<float>::infinity());
+  for (const Vec3f& p : positions) lo = lo.cwiseMin(p);
+  return positions.empty() ? Vec3f::Zero() : lo;
+}
+
+Vec3f Mesh::bounds_max() const {
+  Vec3f hi = Vec3f::Constant(-std::numeric_limits<float>::infinity());
+  for (const Vec3f& p : positions) hi = hi.cwiseMax(p);
+  return positions.empty() ? Vec3f::Zero() : hi;
+}
+
+Vec3f Mesh::centre() const {
+  return 0.5f * (bounds_min() + bounds_max());
+}
+
+float Mesh::bounding_radius() const {
+  const Vec3f c = centre();
+  float r2 = 0;
+  for (const Vec3f& p : positions) r2 = std::max(r2, (p - c).squaredNorm());
+  return std::sqrt(r2);
+}
+
+double Mesh::surface_area() const {
+  double area = 0;
+  for (const auto& t : triangles) {
+    const Eigen::Vector3d a = positions[t[0]].cast<double>(), b = positions[t[1]].cast<double>(),
+                          c = positions[t[2]].cast<double>();
+    area += 0.5 * (b - a).cross(c - a).norm();
+  }
+  return area;
+}
+
+namespace {
+
+// "A,B,C" -> three finite floats, or nothing.
+bool parse_triple(const std::string& text, Vec3f& out) {
+  std::istringstream in(text);
+  std::string field;
+  int n = 0;
+  while (std::getline(in, field, ',')) {
+    if (n == 3 || field.empty()) return false;
+    char* end = nullptr;
+    const double v = std::strtod(field.c_str(), &end);
+    if (end == field.c_str() || *end != '\0' || !std::isfinite(v)) return false;
+    out[n++] = static_cast<float>(v);
+  }
+  return n == 3 && text.back() != ',';
+}
+
+}  // namespace
+
+Light parse_light(const std::string& text) {
+  const std::string expected =
+      "expected directional:DX,DY,DZ:R,G,B (direction toward the light) or point:X,Y,Z:R,G,B "
+      "(position in mm)";
+  const auto bad = [&](const std::string& why) { return Error("--light '" + text + "': " + why); };
+  const auto first = text.find(':');
+  const auto second = first == std::string::npos ? first : text.find(':', first + 1);
+  if (second == std::string::npos || text.find(':', second + 1) != std::string::npos) {
+    throw bad(expected);
+  }
+  const std::string kind = text.substr(0, first);
+  const std::string where = text.substr(first + 1, second - first - 1);
+  const std::string colour = text.substr(second + 1);
+  Light light;
+  if (kind == "directional") {
+    light.type = LightType::kDirectional;
+  } else if (kind == "point") {
+    light.type = LightType::kPoint;
+  } else {
+    throw bad("unknown light type '" + kind + "'; " + expected);
+  }
+  Vec3f v;
+  if (!parse_triple(where, v)) {
+    throw bad(std::string(light.type == LightType::kPoint ? "position" : "direction") +
+              " must be three comma-separated numbers; " + expected);
+  }
+  if (light.type == LightType::kDirectional) {
+    if (!(v.norm() > 0)) throw bad("the direction must not be zero");
+    light.direction = v.normalized();
+  } else {
+    light.position = v;
+  }
+  if (!parse_triple(colour, light.radiance)) {
+    throw bad("the colour must be three comma-separated numbers R,G,B; " + expected);
+  }
+  if ((light.radiance.array() < 0).any()) throw bad("the colour must not be negative");
+  return light;
+}
+
+Camera orbit_camera(const Mesh& mesh, float azimuth_deg, float elevation_deg, float distance_radii,
+                    int width, int height) {
+  if (!(distance_radii > 0) || !std::isfinite(distance_radii)) {
+    throw Error("--view: the distance must be positive (bounding-sphere radii), got " +
+                std::to_string(distance_radii));
+  }
+  if (width <= 0 || height <= 0) {
+    throw Error("--size: the image must be at least 1x1 pixels, got " + std::to_string(width) +
+                "x" + std::to_string(height));
+  }
+  constexpr float kDeg = std::numbers::pi_v<float> / 180.0f;
+  const float az = azimuth_deg * kDeg, el = elevation_deg * kDeg;
+  // Azimuth turns about +y starting from +z; elevation lifts out of the xz-plane.
+  const Vec3f offset(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az));
+  Camera camera;
+  camera.target = mesh.centre();
+  camera.eye = camera.target + distance_radii * mesh.bounding_radius() * offset;
+  // Looking straight down or up, +y is the view direction itself: use the horizontal direction
+  // the camera would have turned from as "up" so the image keeps its azimuth.
+  if (std::abs(std::cos(el)) < 1e-4f) {
+    camera.up = Vec3f(-std::sin(az), 0, -std::cos(az)) * (el > 0 ? 1.0f : -1.0f);
+  }
+  camera.fov_y_deg = 35;
+  camera.width = width;
+  camera.height = height;
+  return camera;
+}
+
+}  // namespace lucent::render
