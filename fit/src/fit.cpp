@@ -570,7 +570,7 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
   }
 
   ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
+  so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;  // 6 parameters: normal equations are tiny
   so.function_tolerance = q.function_tolerance;
   so.parameter_tolerance = q.parameter_tolerance;
   so.gradient_tolerance = 1e-14;
