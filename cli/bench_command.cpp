@@ -4,6 +4,7 @@
 
 #include "commands.h"
 #include "lucent/fit/fit_bench.h"
+#include "lucent/render/render_bench.h"
 
 namespace lucent::cli {
 
@@ -29,6 +30,28 @@ void register_bench_command(CLI::App& app) {
     const int n = fit::run_fit_bench(*options, std::cout);
     std::cout << "bench fit: " << n << " settings; wrote "
               << (options->out_dir / "fit_tradeoff.csv").string() << " and fit_tradeoff.png\n";
+  });
+
+  auto render_options = std::make_shared<render::RenderBenchOptions>();
+  CLI::App* render_cmd = bench->add_subcommand(
+      "render",
+      "Per-stage times (light map, radiance map, mip blur, final) of the radiance-map technique at "
+      "the seed's settings on the bunny and dragon:4..2 -> render.csv");
+  auto& rs = render_options->settings;
+  render_cmd->add_option("--out", render_options->out_csv, "CSV to write")->capture_default_str();
+  render_cmd->add_option("--meshes", render_options->meshes, "meshes to time")->capture_default_str();
+  render_cmd->add_option("--frames", render_options->frames, "frames timed per mesh")
+      ->capture_default_str();
+  render_cmd->add_option("--size", render_options->size, "image size, pixels")->capture_default_str();
+  render_cmd->add_option("--directions", rs.directions, "K")->capture_default_str();
+  render_cmd->add_option("--samples", rs.samples, "N")->capture_default_str();
+  render_cmd->add_option("--disc-points", rs.disc_points, "M")->capture_default_str();
+  render_cmd->add_option("--radiance-map", rs.radiance_map_size, "W_s, texels")->capture_default_str();
+  render_cmd->add_option("--light-map", rs.light_map_size, "W_l, texels")->capture_default_str();
+  render_cmd->callback([render_options] {
+    const int n = render::run_render_bench(*render_options, std::cout);
+    std::cout << "bench render: " << n << " meshes; wrote " << render_options->out_csv.string()
+              << "\n";
   });
 }
 
