@@ -292,38 +292,25 @@ void RadianceMapRenderer::Impl::build_programs() {
   unit(background_program, "u_environment", kUnitEnvironment);
   unit(present_program, "u_image", 0);
 
-  nearest = gl::create_sampler();
-  for (const gl::Sampler* s : {&nearest}) {
-    glSamplerParameteri(s->id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glSamplerParameteri(s->id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glSamplerParameteri(s->id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glSamplerParameteri(s->id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  }
-  linear_clamp = gl::create_sampler();
-  glSamplerParameteri(linear_clamp.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glSamplerParameteri(linear_clamp.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glSamplerParameteri(linear_clamp.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glSamplerParameteri(linear_clamp.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  // One sampler object per way of reading: filters and wrap modes.
+  const auto sampler = [](GLint min_filter, GLint mag_filter, GLint wrap_s) {
+    gl::Sampler s = gl::create_sampler();
+    glSamplerParameteri(s.id(), GL_TEXTURE_MIN_FILTER, min_filter);
+    glSamplerParameteri(s.id(), GL_TEXTURE_MAG_FILTER, mag_filter);
+    glSamplerParameteri(s.id(), GL_TEXTURE_WRAP_S, wrap_s);
+    glSamplerParameteri(s.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return s;
+  };
+  nearest = sampler(GL_NEAREST, GL_NEAREST, GL_CLAMP_TO_EDGE);
+  linear_clamp = sampler(GL_LINEAR, GL_LINEAR, GL_CLAMP_TO_EDGE);
   // The final pass reads one whole level (u_mip_level is an integer): bilinear within it.
-  mip_nearest = gl::create_sampler();
-  glSamplerParameteri(mip_nearest.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
-  glSamplerParameteri(mip_nearest.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glSamplerParameteri(mip_nearest.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glSamplerParameteri(mip_nearest.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  mip_nearest = sampler(GL_LINEAR_MIPMAP_NEAREST, GL_LINEAR, GL_CLAMP_TO_EDGE);
   // Seed Listing 5.9: compare against the stored depth; nearest, as the seed.
-  shadow = gl::create_sampler();
-  glSamplerParameteri(shadow.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-  glSamplerParameteri(shadow.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-  glSamplerParameteri(shadow.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glSamplerParameteri(shadow.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  shadow = sampler(GL_NEAREST, GL_NEAREST, GL_CLAMP_TO_EDGE);
   glSamplerParameteri(shadow.id(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
   glSamplerParameteri(shadow.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
   // Lat-long: wrap in u, clamp in v (as environment_lookup on the CPU).
-  environment_sampler = gl::create_sampler();
-  glSamplerParameteri(environment_sampler.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glSamplerParameteri(environment_sampler.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glSamplerParameteri(environment_sampler.id(), GL_TEXTURE_WRAP_S, GL_REPEAT);
-  glSamplerParameteri(environment_sampler.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  environment_sampler = sampler(GL_LINEAR, GL_LINEAR, GL_REPEAT);
 }
 
 void RadianceMapRenderer::Impl::build_light_maps() {
