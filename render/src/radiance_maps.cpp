@@ -60,24 +60,27 @@ std::string RadianceMapOptions::to_string() const {
   return s.str();
 }
 
-StageTimes RadianceMapStats::mean_wall() const {
-  StageTimes m = sum_wall;
+namespace {
+
+// Per-stage means: the light map is rendered once per restart, the final pass once per displayed
+// frame, the other stages once per accumulated frame.
+StageTimes mean_of(StageTimes sum, int frames, int light_map_renders, int frames_rendered) {
   const double f = std::max(frames, 1);
-  m.light_map_ms /= std::max(light_map_renders, 1);
-  m.radiance_map_ms /= f;
-  m.mip_blur_ms /= f;
-  m.final_ms /= std::max(frames_rendered, 1);
-  return m;
+  sum.light_map_ms /= std::max(light_map_renders, 1);
+  sum.radiance_map_ms /= f;
+  sum.mip_blur_ms /= f;
+  sum.final_ms /= std::max(frames_rendered, 1);
+  return sum;
+}
+
+}  // namespace
+
+StageTimes RadianceMapStats::mean_wall() const {
+  return mean_of(sum_wall, frames, light_map_renders, frames_rendered);
 }
 
 StageTimes RadianceMapStats::mean_gpu() const {
-  StageTimes m = sum_gpu;
-  const double f = std::max(frames, 1);
-  m.light_map_ms /= std::max(light_map_renders, 1);
-  m.radiance_map_ms /= f;
-  m.mip_blur_ms /= f;
-  m.final_ms /= std::max(frames_rendered, 1);
-  return m;
+  return mean_of(sum_gpu, frames, light_map_renders, frames_rendered);
 }
 
 std::string RadianceMapStats::to_string() const {
