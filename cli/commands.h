@@ -12,5 +12,6 @@ void register_acquire_command(CLI::App& app);
 void register_fit_command(CLI::App& app);
 void register_bench_command(CLI::App& app);
 void register_render_command(CLI::App& app);
+void register_view_command(CLI::App& app);
 
 }  // namespace lucent::cli

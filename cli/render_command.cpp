@@ -4,152 +4,44 @@
 // before rendering so that bad input fails fast and leaves no output file.
 #include <unistd.h>
 
-#include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
-#include <iostream>
 #include <memory>
-#include <optional>
 #include <string>
-#include <vector>
 
 #include "commands.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
-#include "lucent/materials/material.h"
-#include "lucent/materials/profile_table.h"
-#include "lucent/render/environment.h"
+#include "lucent/render/radiance_maps.h"
 #include "lucent/render/reference_renderer.h"
 #include "lucent/render/render_settings.h"
 #include "lucent/render/scene.h"
 #include "lucent/render/tone_map.h"
-#if LUCENT_RENDER_HAS_RADIANCE_MAPS
-#include "lucent/render/radiance_maps.h"
-#endif
+#include "scene_options.h"
 
 namespace lucent::cli {
 namespace {
 
 struct RenderArguments {
-  std::string material;
-  std::string mesh = "sphere";
-  std::vector<std::string> lights;
-  std::string env;
-  std::string technique = "maps";
-  std::string model;
-  std::string view = "30,20,3";
-  std::string size = "256x256";
-  double object_size_mm = 100;
+  SceneArguments scene;
   std::string output;
   std::string stats;
-  render::RenderSettings settings;
-  render::ReferenceOptions reference;
 };
-
-std::vector<double> parse_numbers(const std::string& text, const std::string& option,
-                                  std::size_t count, char separator, const std::string& expected) {
-  std::vector<double> values;
-  std::size_t start = 0;
-  for (;;) {
-    const std::size_t end = text.find(separator, start);
-    const std::string field = text.substr(start, end == std::string::npos ? end : end - start);
-    char* stop = nullptr;
-    const double v = std::strtod(field.c_str(), &stop);
-    if (field.empty() || *stop != '\0' || !std::isfinite(v)) {
-      throw Error(option + ": expected " + expected + ", got '" + text + "'");
-    }
-    values.push_back(v);
-    if (end == std::string::npos) break;
-    start = end + 1;
-  }
-  if (values.size() != count)
-    throw Error(option + ": expected " + expected + ", got '" + text + "'");
-  return values;
-}
-
-struct EnvironmentArgument {
-  std::string path;
-  int lights = 16;
-};
-
-// FILE[:L]: the count is split off only when what follows the last ':' is all digits, so paths
-// with colons still work.
-EnvironmentArgument parse_environment_argument(const std::string& text) {
-  EnvironmentArgument env{text, 16};
-  const auto colon = text.rfind(':');
-  if (colon != std::string::npos && colon + 1 < text.size()) {
-    const std::string tail = text.substr(colon + 1);
-    if (std::all_of(tail.begin(), tail.end(), [](unsigned char c) { return std::isdigit(c); })) {
-      env.path = text.substr(0, colon);
-      env.lights = tail.size() > 6 ? 1000000 : std::stoi(tail);
-    }
-  }
-  if (env.path.empty()) throw Error("--env: expected FILE[:L], got '" + text + "'");
-  if (env.lights < 1 || env.lights > 4096) {
-    throw Error("--env: the number of lights L must be 1..4096, got '" + text + "'");
-  }
-  return env;
-}
 
 void print_progress(double fraction) {
   std::fprintf(stderr, "\rrender: %3d%%", int(std::lround(100 * fraction)));
   std::fflush(stderr);
 }
 
-void run_render(RenderArguments& args) {
+void run_render(RenderArguments& render_args) {
   using namespace lucent::render;
-  // Everything that needs no file first, so that typing errors fail before any loading.
-  if (args.output.empty()) throw Error("-o: give the output image (.png or .exr)");
-  if (!is_render_image_path(args.output)) {
-    throw Error("-o: '" + args.output + "': output must be .png (tone-mapped) or .exr (linear)");
+  SceneArguments& args = render_args.scene;
+  if (render_args.output.empty()) throw Error("-o: give the output image (.png or .exr)");
+  if (!is_render_image_path(render_args.output)) {
+    throw Error("-o: '" + render_args.output +
+                "': output must be .png (tone-mapped) or .exr (linear)");
   }
-  const auto size = parse_numbers(args.size, "--size", 2, 'x', "WxH in pixels, e.g. 256x256");
-  if (size[0] < 1 || size[1] < 1 || size[0] > 16384 || size[1] > 16384 ||
-      size[0] != std::floor(size[0]) || size[1] != std::floor(size[1])) {
-    throw Error("--size: width and height must be whole numbers 1..16384, got '" + args.size + "'");
-  }
-  const auto view =
-      parse_numbers(args.view, "--view", 3, ',', "AZ,EL,DIST (degrees, degrees, bounding radii)");
-  if (!(view[2] > 0)) throw Error("--view: DIST must be positive, got '" + args.view + "'");
-  if (args.technique != "maps" && args.technique != "reference") {
-    throw Error("--technique: expected maps or reference, got '" + args.technique + "'");
-  }
-  if (!(args.object_size_mm > 0) || !std::isfinite(args.object_size_mm)) {
-    throw Error("--object-size-mm: must be positive");
-  }
-  if (args.reference.surface_samples < 1) throw Error("--samples-reference: must be at least 1");
-  if (args.reference.passes < 1) throw Error("--passes: must be at least 1");
-  args.settings.validate();
-  std::vector<Light> lights;
-  for (const auto& text : args.lights) lights.push_back(parse_light(text));
-  std::optional<EnvironmentArgument> env;
-  if (!args.env.empty()) env = parse_environment_argument(args.env);
-  if (lights.empty() && !env) {
-    throw Error(
-        "no light: give --light directional:DX,DY,DZ:R,G,B, --light point:X,Y,Z:R,G,B or "
-        "--env FILE[:L]");
-  }
-
-  Scene scene;
-  scene.material = materials::load_material(args.material);
-  const std::string model_name =
-      !args.model.empty() ? args.model
-                          : (!scene.material.model.empty() ? scene.material.model : "ddipole");
-  args.settings.model = materials::parse_diffusion_model(model_name, "--model");
-  scene.mesh = load_mesh(args.mesh, args.object_size_mm);
-  scene.lights = lights;
-  if (env) {
-    const EnvironmentMap map = load_environment(env->path);
-    const auto env_lights = environment_lights(map, env->lights, args.reference.seed);
-    if (env_lights.empty() && lights.empty()) {
-      throw Error("--env: " + env->path + " is black everywhere: no light");
-    }
-    scene.lights.insert(scene.lights.end(), env_lights.begin(), env_lights.end());
-    scene.environment = env->path;
-  }
-  scene.camera = orbit_camera(scene.mesh, float(view[0]), float(view[1]), float(view[2]),
-                              int(size[0]), int(size[1]));
+  Scene scene = build_scene(args).scene;
 
   const bool show_progress = ::isatty(STDERR_FILENO) != 0;
   ImageRgb image;
@@ -161,23 +53,17 @@ void run_render(RenderArguments& args) {
     image = std::move(result.image);
     stats = std::move(result.stats);
   } else {
-#if LUCENT_RENDER_HAS_RADIANCE_MAPS
     image = render_radiance_maps(scene, args.settings, &stats);
-#else
-    throw Error(
-        "--technique maps: the radiance-map technique is not built yet; use --technique "
-        "reference");
-#endif
   }
 
   ToneMapOptions tone;
   tone.exposure = args.settings.exposure;
-  write_render_image(args.output, image, tone,
+  write_render_image(render_args.output, image, tone,
                      {{"lucent:units", "radiance, W mm^-2 sr^-1 per unit light"},
                       {"lucent:material", scene.material.name},
                       {"lucent:mesh", scene.mesh.name},
                       {"lucent:technique", args.technique}});
-  if (!args.stats.empty()) {
+  if (!render_args.stats.empty()) {
     nlohmann::json doc = stats.to_json();
     doc["scene"] = {{"material", scene.material.name},
                     {"model", materials::to_string(args.settings.model)},
@@ -188,7 +74,7 @@ void run_render(RenderArguments& args) {
                     {"environment", args.env},
                     {"view", args.view}};
     if (args.technique == "maps") doc["settings"] = args.settings.to_string();
-    write_file_atomically(args.stats, doc.dump(2) + "\n");
+    write_file_atomically(render_args.stats, doc.dump(2) + "\n");
   }
 }
 
@@ -201,67 +87,8 @@ void register_render_command(CLI::App& app) {
       "Render a material on a mesh (headless). Output: PNG tone-mapped (exposure, Reinhard "
       "x/(1+x) per channel, sRGB) or EXR linear radiance (W mm^-2 sr^-1 per unit light). The mesh "
       "is centred and scaled so that its bounding-box diagonal is --object-size-mm.");
-  cmd->add_option("--material", args->material,
-                  "bundled material name (e.g. marble) or path to a lucent-material JSON file")
-      ->required();
-  cmd->add_option("--mesh", args->mesh,
-                  "sphere, bunny, dragon:1 (finest) .. dragon:4 (coarsest), or a .ply / .obj file")
-      ->capture_default_str();
-  cmd->add_option("--light", args->lights,
-                  "directional:DX,DY,DZ:R,G,B (direction toward the light; R,G,B irradiance on a "
-                  "surface facing it) or point:X,Y,Z:R,G,B (position in mm from the mesh centre; "
-                  "R,G,B intensity per sr); repeatable");
-  cmd->add_option("--env", args->env,
-                  "FILE[:L]: lat-long environment map (.exr or .hdr), shown as background and lit "
-                  "by L importance-sampled directional lights (default L = 16)");
-  cmd->add_option("--technique", args->technique,
-                  "maps (real-time radiance maps, OpenGL) or reference (CPU, slow, exact up to "
-                  "sampling noise)")
-      ->capture_default_str();
-  cmd->add_option("--model", args->model,
-                  "ddipole (directional dipole) or dipole (standard dipole); default: the "
-                  "material's fitted model, else ddipole");
-  cmd->add_option("--view", args->view,
-                  "AZ,EL,DIST: camera azimuth about +y from +z (degrees), elevation (degrees), "
-                  "distance from the centre in bounding-sphere radii; field of view 35 degrees")
-      ->capture_default_str();
-  cmd->add_option("--size", args->size, "image size WxH in pixels")->capture_default_str();
-  cmd->add_option("--object-size-mm", args->object_size_mm, "bounding-box diagonal of the mesh, mm")
-      ->capture_default_str();
-  cmd->add_option("--exposure", args->settings.exposure,
-                  "linear scale before the tone curve (PNG only; EXR stays linear)")
-      ->capture_default_str();
-  cmd->add_option("--samples-reference", args->reference.surface_samples,
-                  "reference: surface samples per pass (uniform by area)")
-      ->capture_default_str();
-  cmd->add_option("--passes", args->reference.passes,
-                  "reference: progressive passes, each with new samples (image = their mean)")
-      ->capture_default_str();
-  cmd->add_option("--threads", args->reference.threads, "reference: worker threads (0 = all)")
-      ->capture_default_str();
-  cmd->add_option("--seed", args->reference.seed,
-                  "random seed (reference samples, environment-light placement)")
-      ->capture_default_str();
-  cmd->add_option("--frames", args->settings.frames, "maps: T, frames accumulated")
-      ->capture_default_str();
-  cmd->add_option("--directions", args->settings.directions,
-                  "maps: K, radiance-map directions (Halton points on the sphere)")
-      ->capture_default_str();
-  cmd->add_option("--samples", args->settings.samples,
-                  "maps: N, disc samples gathered per texel per frame (N <= M)")
-      ->capture_default_str();
-  cmd->add_option("--disc-points", args->settings.disc_points,
-                  "maps: M, exponentially biased Halton disc points")
-      ->capture_default_str();
-  cmd->add_option("--q", args->settings.q,
-                  "maps: q, disc bias sigma* = min sigma_tr / q (q > 1 spreads the samples wider)")
-      ->capture_default_str();
-  cmd->add_option("--radiance-map", args->settings.radiance_map_size,
-                  "maps: W_s, radiance-map size in texels")
-      ->capture_default_str();
-  cmd->add_option("--light-map", args->settings.light_map_size,
-                  "maps: W_l, light-map size in texels")
-      ->capture_default_str();
+  args->scene.size = "256x256";
+  add_scene_options(cmd, args->scene, "image size WxH in pixels");
   cmd->add_option("-o,--output", args->output,
                   "output image: .png (tone-mapped sRGB) or .exr (linear); written atomically")
       ->required();

@@ -266,23 +266,6 @@ void orient_outward(Mesh& mesh) {
   }
 }
 
-// Area-weighted vertex normals: the sum of the (unnormalised) face cross products around a vertex.
-std::vector<Vec3f> area_weighted_normals(const Mesh& mesh) {
-  std::vector<Eigen::Vector3d> sum(mesh.positions.size(), Eigen::Vector3d::Zero());
-  for (const auto& t : mesh.triangles) {
-    const Eigen::Vector3d a = mesh.positions[t[0]].cast<double>(),
-                          b = mesh.positions[t[1]].cast<double>(),
-                          c = mesh.positions[t[2]].cast<double>();
-    const Eigen::Vector3d n = (b - a).cross(c - a);
-    for (unsigned v : t) sum[v] += n;
-  }
-  std::vector<Vec3f> normals(sum.size(), Vec3f(0, 0, 1));
-  for (std::size_t i = 0; i < sum.size(); ++i) {
-    if (sum[i].norm() > 0) normals[i] = sum[i].normalized().cast<float>();
-  }
-  return normals;
-}
-
 // Edges used by one triangle (open boundary) or by more than two. Vertices are welded by exact
 // position first, so that OBJ seams (same position, different texture coordinates) do not count.
 std::size_t count_non_manifold_edges(const Mesh& mesh) {
@@ -351,6 +334,23 @@ bool has_extension(const fs::path& path, const std::string& ext) {
 }
 
 }  // namespace
+
+std::vector<Vec3f> area_weighted_normals(const Mesh& mesh) {
+  std::vector<Eigen::Vector3d> sum(mesh.positions.size(), Eigen::Vector3d::Zero());
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3d a = mesh.positions[t[0]].cast<double>(),
+                          b = mesh.positions[t[1]].cast<double>(),
+                          c = mesh.positions[t[2]].cast<double>();
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    for (unsigned v : t) sum[v] += n;
+  }
+  std::vector<Vec3f> normals(sum.size(), Vec3f(0, 0, 1));
+  for (std::size_t i = 0; i < sum.size(); ++i) {
+    if (sum[i].norm() > 0) normals[i] = sum[i].normalized().cast<float>();
+  }
+  return normals;
+}
+
 
 Mesh load_mesh(const std::string& name_or_path, double object_size_mm) {
   if (!(object_size_mm > 0) || !std::isfinite(object_size_mm)) {

@@ -238,10 +238,11 @@ void RadianceMapRenderer::Impl::upload_mesh() {
   positions = gl::create_buffer();
   normals = gl::create_buffer();
   indices = gl::create_buffer();
+  // Positions and normals stay writable: a deforming mesh replaces them every frame (set_geometry).
   glNamedBufferStorage(positions.id(), GLsizeiptr(m.positions.size() * sizeof(Vec3f)),
-                       m.positions.data(), 0);
+                       m.positions.data(), GL_DYNAMIC_STORAGE_BIT);
   glNamedBufferStorage(normals.id(), GLsizeiptr(m.normals.size() * sizeof(Vec3f)), m.normals.data(),
-                       0);
+                       GL_DYNAMIC_STORAGE_BIT);
   glNamedBufferStorage(indices.id(), GLsizeiptr(m.triangles.size() * sizeof(m.triangles[0])),
                        m.triangles.data(), 0);
   static_assert(sizeof(Vec3f) == 3 * sizeof(float));
@@ -691,6 +692,32 @@ void RadianceMapRenderer::set_lights(const std::vector<Light>& lights) {
   impl_->L = int(lights.size());
   if (resize) impl_->build_light_maps();
   impl_->upload_lights();
+  restart();
+}
+
+void RadianceMapRenderer::set_geometry(const std::vector<Vec3f>& positions,
+                                       const std::vector<Vec3f>& normals) {
+  Impl& m = *impl_;
+  if (positions.size() != m.scene.mesh.positions.size() ||
+      normals.size() != m.scene.mesh.positions.size()) {
+    throw Error("radiance maps: a deformed mesh must keep its " +
+                std::to_string(m.scene.mesh.positions.size()) + " vertices (got " +
+                std::to_string(positions.size()) + " positions, " + std::to_string(normals.size()) +
+                " normals)");
+  }
+  m.scene.mesh.positions = positions;
+  m.scene.mesh.normals = normals;
+  glNamedBufferSubData(m.positions.id(), 0, GLsizeiptr(positions.size() * sizeof(Vec3f)),
+                       positions.data());
+  glNamedBufferSubData(m.normals.id(), 0, GLsizeiptr(normals.size() * sizeof(Vec3f)),
+                       normals.data());
+  // Nothing is precomputed per mesh beyond what depends on its bounds: the layer and light cameras
+  // are refitted, the radiance maps' depth pre-pass redone, and accumulation restarts.
+  m.centre = m.scene.mesh.centre();
+  m.radius_mm = m.scene.mesh.bounding_radius();
+  m.upload_layers();
+  m.upload_lights();
+  m.render_radiance_depth();
   restart();
 }
 

@@ -100,6 +100,9 @@ class RadianceMapRenderer {
   /// New lights (at most 16), or a new material: accumulation restarts.
   void set_lights(const std::vector<Light>& lights);
   void set_material(const materials::Material& material);
+  /// A deforming mesh: new positions (mm) and unit normals for the same vertices and triangles.
+  /// The layer and light cameras are refitted to the new bounds; accumulation restarts.
+  void set_geometry(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals);
   /// Discards the accumulated frames (call after any change the renderer cannot see).
   void restart();
 

@@ -77,4 +77,9 @@ Light parse_light(const std::string& text);
 /// non-manifold ones load with a warning on stderr.
 Mesh load_mesh(const std::string& name_or_path, double object_size_mm = 100.0);
 
+/// Area-weighted vertex normals: the normalised sum of the (unnormalised) face cross products around
+/// each vertex; +z where the sum vanishes. load_mesh uses them where a file has no normals, and a
+/// deforming mesh recomputes them every frame.
+std::vector<Vec3f> area_weighted_normals(const Mesh& mesh);
+
 }  // namespace lucent::render

@@ -1,0 +1,43 @@
+// The options `lucent render` and `lucent view` share (material, mesh, lights, environment, camera,
+// technique, the radiance-map knobs and the reference's), and the Scene they describe. Everything
+// that needs no file is validated first, so that typing errors fail before any loading.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "lucent/render/reference_renderer.h"
+#include "lucent/render/render_settings.h"
+#include "lucent/render/scene.h"
+
+namespace lucent::cli {
+
+struct SceneArguments {
+  std::string material;
+  std::string mesh = "sphere";
+  std::vector<std::string> lights;
+  std::string env;
+  std::string technique = "maps";
+  std::string model;
+  std::string view = "30,20,3.4";  // 3.4 radii: the bounding sphere fits the 35-degree view
+  std::string size;
+  double object_size_mm = 100;
+  render::RenderSettings settings;
+  render::ReferenceOptions reference;
+};
+
+/// Adds the shared options to `cmd`; `size_help` says what --size is (image or window).
+void add_scene_options(CLI::App* cmd, SceneArguments& args, const std::string& size_help);
+
+struct SceneSetup {
+  render::Scene scene;  ///< camera from --view and --size; material loaded; lights incl. --env's
+  float azimuth_deg = 0, elevation_deg = 0, distance_radii = 0;  ///< --view
+};
+
+/// Validates the arguments (one lucent::Error naming the option on the first bad one), then loads
+/// the material, mesh and environment. Sets args.settings.model from --model or the material.
+SceneSetup build_scene(SceneArguments& args);
+
+}  // namespace lucent::cli

@@ -1,0 +1,80 @@
+// `lucent view`: the same scene options as `lucent render`, shown in a window with live controls
+// (lucent::render::run_viewer). Needs an X display; `xvfb-run -a lucent view ...` gives a virtual one.
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "commands.h"
+#include "lucent/materials/error.h"
+#include "scene_options.h"
+#if LUCENT_HAS_VIEWER
+#include "lucent/render/viewer.h"
+#endif
+
+namespace lucent::cli {
+namespace {
+
+struct ViewArguments {
+  SceneArguments scene;
+  float deform = 0;
+  std::string script;
+};
+
+void run_view(ViewArguments& args) {
+#if LUCENT_HAS_VIEWER
+  if (!(args.deform >= 0 && args.deform <= 0.2f)) {
+    throw Error("--deform: expected an amplitude in [0, 0.2] (fraction of the object's size)");
+  }
+  // The maps' shader cache is of no use for one short session and fails on read-only homes.
+  setenv("MESA_SHADER_CACHE_DISABLE", "true", 0);
+  const bool model_given = !args.scene.model.empty();
+  SceneSetup setup = build_scene(args.scene);
+  render::ViewerOptions options;
+  options.scene = std::move(setup.scene);
+  options.material_source = args.scene.material;
+  options.settings = args.scene.settings;
+  options.model_follows_material = !model_given;
+  options.reference = args.scene.reference;
+  options.view = {setup.azimuth_deg, setup.elevation_deg, setup.distance_radii};
+  options.object_size_mm = args.scene.object_size_mm;
+  options.technique = args.scene.technique;
+  options.deform_amplitude = args.deform;
+  options.script = args.script;
+  const int status = render::run_viewer(options);
+  if (status != 0) std::exit(status);
+#else
+  (void)args;
+  throw Error("view: this lucent was built without the window (LUCENT_WITH_VIEWER=OFF)");
+#endif
+}
+
+}  // namespace
+
+void register_view_command(CLI::App& app) {
+  auto args = std::make_shared<ViewArguments>();
+  CLI::App* cmd = app.add_subcommand(
+      "view",
+      "Preview a material on a mesh in a window (GLFW; needs an X display, e.g. xvfb-run -a). "
+      "Left drag orbits, the wheel zooms, right drag moves a light, S saves a screenshot "
+      "(lucent_view_NNN.png), R restarts, H hides the panel, Esc quits. The panel switches the "
+      "material (library or file, reloaded when the file changes), technique and model, and has "
+      "sliders for N, M, q, K, W_s, W_l, T, exposure, object size and the deformer.");
+  // The reference in the window runs pass after pass at half the window's resolution: fewer
+  // samples per pass than `lucent render`'s default keep the first picture quick.
+  args->scene.reference.surface_samples = 20000;
+  args->scene.size = "960x720";
+  add_scene_options(cmd, args->scene, "window size WxH in pixels");
+  cmd->add_option("--deform", args->deform,
+                  "sine deformer: amplitude as a fraction of the bounding-box diagonal (0 = off, "
+                  "at most 0.2); the mesh moves every frame and the maps restart with it")
+      ->capture_default_str();
+  cmd->add_option("--script", args->script,
+                  "actions, one per frame, separated by ';': orbit DX DY, light DX DY (pixels), "
+                  "zoom STEPS, set NAME VALUE (N M q K Ws Wl T exposure size deform technique "
+                  "model), key LETTER, wait FRAMES, sleep SECONDS, settle (until the maps converge or the "
+                  "reference has a pass), screenshot FILE.png, restart, quit");
+  cmd->callback([args] { run_view(*args); });
+}
+
+}  // namespace lucent::cli

@@ -1,0 +1,46 @@
+// `lucent view`: the material preview window (GLFW + Dear ImGui, OpenGL 4.5 core). The radiance
+// maps accumulate while nothing changes and restart when something does; the CPU reference can be
+// switched in (progressive passes on worker threads, shown as they finish).
+//
+// Controls: left drag orbits, the wheel zooms, right drag moves the selected light around the
+// object; S saves a screenshot (lucent_view_NNN.png in the working folder), R restarts the
+// accumulation, H hides the panel, Esc quits. The panel has the material (library or file, the
+// file reloaded when it changes), the technique and model, sliders for N, M, q, K, W_s, W_l, T,
+// exposure and object size, the sine deformer, per-stage times and the accumulated frames.
+#pragma once
+
+#include <string>
+
+#include "lucent/render/reference_renderer.h"
+#include "lucent/render/render_settings.h"
+#include "lucent/render/scene.h"
+#include "lucent/render/viewer_controls.h"
+
+namespace lucent::render {
+
+struct ViewerOptions {
+  Scene scene;                     ///< camera width x height = the window's initial size
+  std::string material_source;     ///< library name or file path (a file is watched and reloaded)
+  RenderSettings settings;         ///< the radiance-map knobs and the model
+  bool model_follows_material = true;  ///< no --model: a newly chosen material brings its model
+  ReferenceOptions reference;      ///< surface samples per pass, threads and seed for the reference
+  OrbitView view;                  ///< --view
+  double object_size_mm = 100;     ///< the mesh's bounding-box diagonal as loaded
+  std::string technique = "maps";  ///< maps | reference
+  float deform_amplitude = 0;      ///< sine deformer: fraction of the diagonal; 0 = off
+  /// Actions, one per frame, separated by ';' (tests and demos drive the window with them):
+  ///   orbit DX DY | light DX DY   mouse drags in pixels (left button / right button)
+  ///   zoom STEPS                  scroll-wheel steps (up = closer)
+  ///   set NAME VALUE              N, M, q, K, Ws, Wl, T, exposure, size, deform, technique, model
+  ///   key LETTER                 a key press (S, R, H)
+  ///   wait FRAMES | sleep SECONDS
+  ///   settle                      until the maps converge or the reference has a pass (<= 300 s)
+  ///   screenshot FILE.png | restart | quit
+  std::string script;
+};
+
+/// Opens the window and runs until it is closed (or the script quits). Returns the exit status.
+/// Throws lucent::Error when no window or OpenGL 4.5 context can be made, or on a bad script.
+int run_viewer(const ViewerOptions& options);
+
+}  // namespace lucent::render
