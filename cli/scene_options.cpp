@@ -120,6 +120,11 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
   cmd->add_option("--q", args->settings.q,
                   "maps: q, disc bias sigma* = min sigma_tr / q (q > 1 spreads the samples wider)")
       ->capture_default_str();
+  cmd->add_option("--disc-selection", args->disc_selection,
+                  "maps: which N of the M points a frame gathers: strata (one of each of N radius "
+                  "strata, a new one every frame: converges to all M after M/N frames) or nearest "
+                  "(seed 003: the N nearest, every frame; misses the far profile)")
+      ->capture_default_str();
   cmd->add_option("--radiance-map", args->settings.radiance_map_size,
                   "maps: W_s, radiance-map size in texels")
       ->capture_default_str();
@@ -147,6 +152,7 @@ SceneSetup build_scene(SceneArguments& args) {
   }
   if (args.reference.surface_samples < 1) throw Error("--samples-reference: must be at least 1");
   if (args.reference.passes < 1) throw Error("--passes: must be at least 1");
+  args.settings.disc_selection = parse_disc_selection(args.disc_selection);
   args.settings.validate();
   std::vector<Light> lights;
   for (const auto& text : args.lights) lights.push_back(parse_light(text));

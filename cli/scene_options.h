@@ -24,6 +24,7 @@ struct SceneArguments {
   std::string view = "30,20,3.4";  // 3.4 radii: the bounding sphere fits the 35-degree view
   std::string size;
   double object_size_mm = 100;
+  std::string disc_selection = "strata";
   render::RenderSettings settings;
   render::ReferenceOptions reference;
 };

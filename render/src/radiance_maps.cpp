@@ -460,7 +460,9 @@ void RadianceMapRenderer::Impl::upload_disc(int t) {
   const double box = (scene.mesh.bounds_max() - scene.mesh.bounds_min()).norm();
   disc = detail::exponential_disc_samples(settings.disc_points, settings.samples,
                                           detail::sigma_star(scene.material, settings.q), box, L,
-                                          detail::frame_shift(t));
+                                          options.new_radii_each_frame ? detail::frame_shift(t)
+                                                                       : Eigen::Vector3d::Zero(),
+                                          settings.disc_selection, t);
   std::vector<float> packed(std::size_t(settings.samples) * 4, 0.0f);
   for (std::size_t i = 0; i < disc.samples.size(); ++i) {
     packed[i * 4 + 0] = disc.samples[i].x_mm;
@@ -553,7 +555,9 @@ void RadianceMapRenderer::Impl::render_radiance() {
   // Frame t (1-based) writes buffer t % 2 and reads the sum so far from the other (seed §5.3.3).
   const int t = frame;
   const int target = t % 2, previous = 1 - target;
-  if (options.new_radii_each_frame) upload_disc(t);
+  if (options.new_radii_each_frame || settings.disc_selection == DiscSelection::kStrata) {
+    upload_disc(t);
+  }
   const int W = settings.radiance_map_size;
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, radiance_fbo[target].id());
   glViewport(0, 0, W, W);

@@ -57,7 +57,8 @@ Eigen::Vector3d frame_shift(int t) {
 }
 
 DiscSamples exponential_disc_samples(int M, int N, double sigma_star_per_mm, double disc_radius_mm,
-                                     int lights, const Eigen::Vector3d& shift) {
+                                     int lights, const Eigen::Vector3d& shift,
+                                     DiscSelection selection, int frame) {
   if (M < 1 || N < 1 || N > M) {
     throw Error("--samples/--disc-points: need 1 <= N <= M, got N=" + std::to_string(N) +
                 ", M=" + std::to_string(M));
@@ -88,7 +89,9 @@ DiscSamples exponential_disc_samples(int M, int N, double sigma_star_per_mm, dou
   }
   std::stable_sort(kept.begin(), kept.end(),
                    [](const Point& a, const Point& b) { return a.r < b.r; });
-  out.used_radius_mm = N < M ? 0.5 * (kept[std::size_t(N) - 1].r + kept[std::size_t(N)].r) : R;
+  const bool strata = selection == DiscSelection::kStrata;
+  out.used_radius_mm =
+      N < M && !strata ? 0.5 * (kept[std::size_t(N) - 1].r + kept[std::size_t(N)].r) : R;
   // Z(rho) = integral over the disc of radius rho of e^(-sigma* r) dA
   //        = 2 pi / sigma*^2 (1 - e^(-sigma* rho) (1 + sigma* rho)), pi rho^2 for sigma* = 0.
   const double sigma = sigma_star_per_mm, rho = out.used_radius_mm;
@@ -97,15 +100,34 @@ DiscSamples exponential_disc_samples(int M, int N, double sigma_star_per_mm, dou
                       2 * std::numbers::pi / (sigma * sigma) * std::exp(-sigma * rho) * sigma * rho
                 : std::numbers::pi * rho * rho;
 
-  // Round-robin over the radius-sorted points gives every light the same spread of radii.
+  // The N points of this frame and how many of the M each stands for.
   const int L = std::min(lights, N);
+  const int t = std::max(frame, 1) - 1;
+  std::vector<std::pair<const Point*, double>> chosen;
+  for (int i = 0; i < N; ++i) {
+    if (!strata) {
+      chosen.emplace_back(&kept[std::size_t(i)], 1.0);
+      continue;
+    }
+    // Stratum i goes to light (i + t) mod L, so that over L frames every light gathers every
+    // stratum; the point within the stratum advances every L frames.
+    const long begin = long(i) * M / N, end = long(i + 1) * M / N;
+    const long size = end - begin;
+    const long pick = begin + (t / L) % size;
+    chosen.emplace_back(&kept[std::size_t(pick)], double(size) * N / M);
+  }
+  // Light l takes every L-th of the radius-sorted points (round-robin: the same spread of radii
+  // for every light), in strata mode shifted by the frame.
+  const int rotation = strata ? t % L : 0;
   for (int l = 0; l < lights; ++l) {
     out.light_offset.push_back(int(out.samples.size()));
+    const int first = ((l % L) - rotation + L) % L;
     int count = 0;
-    for (int i = l % L; i < N; i += L) ++count;
-    for (int i = l % L; i < N; i += L) {
-      const Point& p = kept[std::size_t(i)];
-      out.samples.push_back({float(p.x), float(p.y), float(Z * std::exp(sigma * p.r) / count)});
+    for (int i = first; i < N; i += L) ++count;
+    for (int i = first; i < N; i += L) {
+      const auto& [p, share] = chosen[std::size_t(i)];
+      out.samples.push_back(
+          {float(p->x), float(p->y), float(Z * std::exp(sigma * p->r) * share / count)});
     }
     out.light_count.push_back(int(out.samples.size()) - out.light_offset.back());
   }

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "lucent/materials/material.h"
+#include "lucent/render/render_settings.h"
 #include "lucent/render/scene.h"
 
 namespace lucent::render::detail {
@@ -62,9 +63,20 @@ struct DiscSamples {
 /// `shift` (each in [0, 1)) moves the three Halton coordinates modulo 1 (a Cranley-Patterson
 /// rotation): shift 0 is the seed's fixed set; a different shift per frame gives every frame new
 /// radii (RadianceMapOptions::new_radii_each_frame).
+///
+/// DiscSelection::kStrata (an extension, lucent's default) instead splits the M radius-sorted points
+/// into N strata of M/N consecutive radii and uses one point of each per frame, frame t the
+/// ((t - 1) mod size)-th of its stratum, weighted w_i = Z(R) e^(sigma* r_i) size_i / M (times
+/// N / n_l for light l's share): every frame is an estimate of the whole disc's integral, and after
+/// M/N frames every point has been used once, so the accumulation converges to the seed's N = M
+/// image (its closest to the path-traced reference, §6.2.2) at the cost of N per frame. With L
+/// lights sharing the N, stratum i goes to light (i + t - 1) mod L and the point within a stratum
+/// advances every L frames: L M / N frames gather every point for every light.
 DiscSamples exponential_disc_samples(int M, int N, double sigma_star_per_mm, double disc_radius_mm,
                                      int lights,
-                                     const Eigen::Vector3d& shift = Eigen::Vector3d::Zero());
+                                     const Eigen::Vector3d& shift = Eigen::Vector3d::Zero(),
+                                     DiscSelection selection = DiscSelection::kNearest,
+                                     int frame = 1);
 
 /// The shift of frame t (1-based; frame 1 unshifted): the additive recurrence t * (1/phi_3,
 /// 1/phi_3^2, 1/phi_3^3), phi_3 the plastic number (a low-discrepancy sequence in 3D, Roberts

@@ -43,6 +43,16 @@ std::string RenderSettings::to_string() const {
   return s.str();
 }
 
+DiscSelection parse_disc_selection(const std::string& text) {
+  if (text == "nearest") return DiscSelection::kNearest;
+  if (text == "strata") return DiscSelection::kStrata;
+  throw Error("--disc-selection: expected nearest (seed 003) or strata, got '" + text + "'");
+}
+
+std::string to_string(DiscSelection selection) {
+  return selection == DiscSelection::kNearest ? "nearest" : "strata";
+}
+
 nlohmann::json RenderStats::to_json() const {
   nlohmann::json passes = nlohmann::json::array();
   for (const auto& [name, ms] : pass_ms) passes.push_back({{"name", name}, {"ms", ms}});

@@ -61,7 +61,9 @@ std::vector<ScriptAction> parse_script(const std::string& text) {
                      std::isalpha(static_cast<unsigned char>(action.args[0][0]))) ||
                     ((v == "restart" || v == "settle" || v == "quit") && n == 0);
     if (!ok) {
-      throw Error("--script: '" + item +
+      const auto first = item.find_first_not_of(' ');
+      const auto last = item.find_last_not_of(' ');
+      throw Error("--script: '" + item.substr(first, last - first + 1) +
                   "': expected orbit DX DY, light DX DY, zoom STEPS, set NAME VALUE, key LETTER, "
                   "wait FRAMES, sleep SECONDS, settle, screenshot FILE.png, restart or quit");
     }
@@ -542,6 +544,10 @@ void Viewer::rebuild_maps() {
 
 void Viewer::set_parameter(const std::string& name, const std::string& value) {
   if (name == "technique") return set_technique(value);
+  if (name == "disc") {
+    settings_.disc_selection = pending_.disc_selection = parse_disc_selection(value);
+    return rebuild_maps();
+  }
   if (name == "model") {
     settings_.model = materials::parse_diffusion_model(value, "--script set model");
     pending_ = settings_;
@@ -565,7 +571,7 @@ void Viewer::set_parameter(const std::string& name, const std::string& value) {
     else if (name == "T") next.frames = int(v);
     else
       throw Error("--script: set " + name +
-                  ": expected N, M, q, K, Ws, Wl, T, exposure, size, deform, technique or model");
+                  ": expected N, M, q, K, Ws, Wl, T, exposure, size, deform, disc, technique or model");
     next.validate();
     settings_ = pending_ = next;
     rebuild_maps();
@@ -751,6 +757,11 @@ void Viewer::draw_ui() {
   // The speed/accuracy knobs: applied when a slider is let go (they rebuild the maps).
   section("radiance maps");
   bool apply = false;
+  int disc = pending_.disc_selection == DiscSelection::kStrata ? 0 : 1;
+  if (ImGui::RadioButton("strata", &disc, 0) || ImGui::RadioButton("N nearest (seed)", &disc, 1)) {
+    pending_.disc_selection = disc == 0 ? DiscSelection::kStrata : DiscSelection::kNearest;
+    apply = true;
+  }
   ImGui::SliderInt("N samples", &pending_.samples, 1, std::min(pending_.disc_points, 512));
   apply |= slider_done();
   ImGui::SliderInt("M disc points", &pending_.disc_points, 1, 4000);

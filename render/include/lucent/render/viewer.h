@@ -31,7 +31,8 @@ struct ViewerOptions {
   /// Actions, one per frame, separated by ';' (tests and demos drive the window with them):
   ///   orbit DX DY | light DX DY   mouse drags in pixels (left button / right button)
   ///   zoom STEPS                  scroll-wheel steps (up = closer)
-  ///   set NAME VALUE              N, M, q, K, Ws, Wl, T, exposure, size, deform, technique, model
+  ///   set NAME VALUE              N, M, q, K, Ws, Wl, T, exposure, size, deform, disc,
+  ///                               technique, model
   ///   key LETTER                 a key press (S, R, H)
   ///   wait FRAMES | sleep SECONDS
   ///   settle                      until the maps converge or the reference has a pass (<= 300 s)

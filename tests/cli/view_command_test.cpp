@@ -1,0 +1,182 @@
+// End-to-end tests of `lucent view` under a virtual X server (xvfb-run): the window opens, a script
+// drives it (orbit, light drag, key presses, settings, the deformer, the CPU reference, a material
+// file edited while it runs) and screenshots show what it drew. Bad input fails with one line.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include "cli_runner.h"
+#include "lucent/acquire/image_io.h"
+
+namespace lucent::testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool have_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
+
+// Tiny settings: llvmpipe renders a 64-texel, 8-direction frame in ~0.1 s.
+const std::string kTiny =
+    " --mesh sphere --size 200x150 --frames 8 --directions 8 --samples 8 --disc-points 32"
+    " --radiance-map 64 --light-map 64 --samples-reference 4000 --threads 2";
+
+struct Shot {
+  acquire::RawImage image;
+  double mean[3] = {0, 0, 0};  // radiance x exposure over the pixels brighter than the background
+  long lit = 0;
+};
+
+// The window's tone curve undone: sRGB decoded, then Reinhard's x / (1 + x) inverted.
+double radiance_of(int code) {
+  const double v = std::min(code, 254) / 255.0;
+  const double linear = v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+  return linear / (1 - linear);
+}
+
+Shot load_shot(const fs::path& path) {
+  Shot shot;
+  shot.image = acquire::read_raw_image(path);
+  for (int y = 0; y < shot.image.height; ++y) {
+    for (int x = 0; x < shot.image.width; ++x) {
+      const int sum = shot.image.at(x, y, 0) + shot.image.at(x, y, 1) + shot.image.at(x, y, 2);
+      if (sum <= 6) continue;
+      ++shot.lit;
+      for (int c = 0; c < 3; ++c) shot.mean[c] += radiance_of(shot.image.at(x, y, c));
+    }
+  }
+  for (double& m : shot.mean) m /= double(std::max(shot.lit, 1L));
+  return shot;
+}
+
+long differing_pixels(const Shot& a, const Shot& b) {
+  long n = 0;
+  for (std::size_t i = 0; i < a.image.data.size(); i += 3) {
+    if (std::abs(int(a.image.data[i]) - int(b.image.data[i])) > 8) ++n;
+  }
+  return n;
+}
+
+class ViewCommand : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!have_xvfb()) GTEST_SKIP() << "xvfb-run not found (scripts/install-deps installs xvfb)";
+    dir_ = scratch_dir("view");
+  }
+  void TearDown() override {
+    if (!dir_.empty()) fs::remove_all(dir_);
+  }
+  // Runs `lucent view ARGS` in dir_ under a fresh virtual X server.
+  CommandResult view(const std::string& args, const std::string& before = "") {
+    const std::string command = "cd \"" + dir_.string() + "\" || exit 1; " + before +
+                                "MESA_SHADER_CACHE_DISABLE=true xvfb-run -a -s '-screen 0 "
+                                "640x480x24' \"" LUCENT_BINARY "\" view " + args;
+    const fs::path out = dir_ / "stdout", err = dir_ / "stderr";
+    const int status =
+        std::system((command + " >\"" + out.string() + "\" 2>\"" + err.string() + "\"").c_str());
+    CommandResult result;
+    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+    result.out = read_text(out);
+    result.err = read_text(err);
+    return result;
+  }
+  fs::path dir_;
+};
+
+TEST_F(ViewCommand, ScriptOrbitsMovesTheLightAndSavesScreenshots) {
+  const CommandResult r = view(
+      "--material marble --light directional:1,0.3,0.5:1,1,1" + kTiny +
+      " --script 'settle; key h; screenshot a.png; orbit 150 0; wait 2; screenshot b.png;"
+      " light 150 0; settle; screenshot c.png; key h; wait 2; screenshot d.png; key s; quit'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* name : {"a.png", "b.png", "c.png", "d.png", "lucent_view_001.png"}) {
+    ASSERT_TRUE(fs::exists(dir_ / name)) << name << "\n" << r.out << r.err;
+  }
+  const Shot a = load_shot(dir_ / "a.png"), b = load_shot(dir_ / "b.png"),
+             c = load_shot(dir_ / "c.png"), d = load_shot(dir_ / "d.png");
+  EXPECT_EQ(a.image.width, 200);
+  EXPECT_EQ(a.image.height, 150);
+  // The sphere at 3.4 radii nearly fills the 35-degree frame's height (a disc of ~73 px radius,
+  // ~16,900 px; its unlit side may sink into the background); marble is light grey.
+  EXPECT_GT(a.lit, 5000);
+  EXPECT_LT(a.lit, 17500);
+  EXPECT_GT(a.mean[0], 0.05);
+  // Orbiting moves the lit side across the image, and does not restart the accumulation
+  // (the maps are view independent); moving the light does.
+  EXPECT_GT(differing_pixels(a, b), 300);
+  EXPECT_GT(differing_pixels(b, c), 300);
+  EXPECT_NE(r.out.find("2 restarts"), std::string::npos) << r.out;  // setup + light drag
+  // H toggled the panel back on: the top-left corner now shows it.
+  EXPECT_GT(differing_pixels(c, d), 2000);
+  EXPECT_NE(r.out.find("accumulated 8 of 8"), std::string::npos) << r.out;
+}
+
+TEST_F(ViewCommand, ReloadsAnEditedMaterialDeformsAndShowsTheReference) {
+  fs::copy_file(fs::path(LUCENT_SOURCE_DIR) / "materials/library/marble.json",
+                dir_ / "sample.json");
+  // Edit the file while the window is open: once a.png exists, ketchup replaces marble.
+  const std::string edit = "(for i in $(seq 600); do [ -f a.png ] && break; sleep 0.1; done; cp \"" +
+                           (fs::path(LUCENT_SOURCE_DIR) / "materials/library/ketchup.json").string() +
+                           "\" sample.json) & ";
+  const CommandResult r = view(
+      "--material sample.json --light directional:0,0.3,1:1,1,1" + kTiny +
+      " --script 'settle; key h; screenshot a.png; sleep 3; settle; screenshot b.png;"
+      " set deform 0.1; wait 3; screenshot c.png; set deform 0; set technique reference; settle;"
+      " screenshot d.png; quit'",
+      edit);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("sample.json changed, reloading"), std::string::npos) << r.out;
+  for (const char* name : {"a.png", "b.png", "c.png", "d.png"}) {
+    ASSERT_TRUE(fs::exists(dir_ / name)) << name << "\n" << r.out << r.err;
+  }
+  const Shot a = load_shot(dir_ / "a.png"), b = load_shot(dir_ / "b.png"),
+             c = load_shot(dir_ / "c.png"), d = load_shot(dir_ / "d.png");
+  // Marble is a warm grey, ketchup red: the red-to-blue ratio grows by far once the edited file is
+  // reloaded.
+  const double warm = a.mean[0] / a.mean[2], red = b.mean[0] / b.mean[2];
+  std::printf("red/blue: marble %.2f, ketchup %.2f (maps), %.2f (reference)\n", warm, red,
+              d.mean[0] / d.mean[2]);
+  EXPECT_LT(warm, 2.2);  // measured 1.85
+  EXPECT_GT(red, 1.3 * warm);  // measured 2.92 = 1.6 x marble
+  // The deformed sphere is another shape.
+  EXPECT_GT(differing_pixels(b, c), 300);
+  // The reference (a pass at half the window's resolution) shows a red sphere of the same size.
+  EXPECT_GT(d.lit, b.lit / 2);
+  EXPECT_LT(d.lit, b.lit * 2);
+  EXPECT_GT(d.mean[0] / d.mean[2], 1.3 * warm);  // measured 3.05
+}
+
+TEST_F(ViewCommand, BadInputFailsWithOneLine) {
+  CommandResult r = view("--material no_such_material --light directional:0,0,1:1,1,1");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("no_such_material"), std::string::npos) << r.err;
+  r = view("--material marble");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("no light"), std::string::npos) << r.err;
+  r = view("--material marble --light directional:0,0,1:1,1,1 --size 0x10");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("--size"), std::string::npos) << r.err;
+  r = view("--material marble --light directional:0,0,1:1,1,1" + kTiny +
+           " --script 'orbit 1 2; fly away'");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("--script: 'fly away'"), std::string::npos) << r.err;
+  r = view("--material marble --light directional:0,0,1:1,1,1 --deform 2");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("--deform"), std::string::npos) << r.err;
+  // No X display at all: it says what to do.
+  const std::string no_display = "env -u DISPLAY \"" LUCENT_BINARY
+                                 "\" view --material marble --light directional:0,0,1:1,1,1";
+  const int status = std::system((no_display + " >/dev/null 2>\"" + (dir_ / "e").string() + "\"").c_str());
+  EXPECT_NE(status, 0);
+  EXPECT_NE(read_text(dir_ / "e").find("xvfb-run"), std::string::npos) << read_text(dir_ / "e");
+  for (const auto& entry : fs::directory_iterator(dir_)) {
+    EXPECT_NE(entry.path().extension(), ".png") << entry.path();  // nothing written
+  }
+}
+
+}  // namespace
+}  // namespace lucent::testing
