@@ -12,5 +12,3 @@ lucent_add_test(radiance_maps_test
 foreach(t glsl_twin_test radiance_maps_test)
   target_include_directories(${t} PRIVATE ${PROJECT_SOURCE_DIR}/render/src)
 endforeach()
-add_executable(experiment_tmp /tmp/exp/experiment.cpp)
-target_link_libraries(experiment_tmp lucent::render lucent::materials OpenGL::OpenGL)

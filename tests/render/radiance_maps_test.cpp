@@ -6,6 +6,8 @@
 // OpenGL 4.5 context can be made.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -280,60 +282,207 @@ TEST_F(RadianceMapsTest, RejectsWhatItCannotRender) {
   EXPECT_THROW(renderer.setup(scene, settings), Error);
 }
 
-// Relative RMSE over the object's pixels against the CPU reference (render_reference), for three
-// materials on a sphere under one directional light, one point light and both, after the first
-// frame and after T frames. What dominates the error is measured here, not sampling noise: with the
-// seed's disc (the N = 16 of M = 1000 points nearest x_o) the gather covers a disc of only
-// rho = 2-3 mm (marble, potato) and misses the far tail of the profile, so the maps come out at
-// about half the reference (mean ratio 0.49-0.63 measured at these settings: 40 px, W_s = 64, 20000
-// reference samples) and the relative RMSE is 0.5-1.1. Accumulating more frames only rotates the
-// same radii, so the error after T frames is about the error after one. The bounds are the measured
-// values at these settings plus 25%; they guard against regressions (a wrong weight or visibility
-// moves them by factors), not the method's accuracy, which the printed numbers report. The first
-// frame is blurred (mip level 1) and the last is not, so the last may be slightly worse (up to
-// 0.05).
-TEST_F(RadianceMapsTest, ErrorAgainstTheCpuReference) {
-  struct Case {
-    const char* material;
-    double bound;  // relative RMSE
-  };
-  const Case cases[] = {{"marble", 0.95}, {"potato", 0.8}, {"ketchup", 1.4}};
-  const int T = 4;
-  for (const Case& c : cases) {
+// Relative RMSE over the object's pixels against the CPU reference (render_reference, 4 passes of
+// 20,000 surface samples), for marble, potato and ketchup under one directional light, one point
+// light and both, on a sphere and on the coarsest dragon (40 px, K = 8, W_s = W_l = 64, N = 16).
+//
+// The seed's disc (DiscSelection::kNearest: the N = 16 of M = 1000 points nearest x_o every frame)
+// gathers a disc of only rho = 2-3 mm and misses the profile beyond it: its image is 0.5-0.65 of the
+// reference's mean, worst in the channel that scatters farthest, and more frames only rotate the
+// same radii (measured relative RMSE 0.51-0.97). The bound on it is its mean ratio in [0.3, 0.8]:
+// the test documents the bias, it does not excuse it.
+//
+// lucent's default (kStrata, N = 16 of M = 128: every point gathered for every light after
+// L M / N = 8-16 frames) converges toward the reference. Measured after T = 16 frames (llvmpipe,
+// this commit), relative RMSE per case (directional, point, both): sphere marble 0.30 0.33 0.28,
+// potato 0.11 0.12 0.11, ketchup 0.51 0.41 0.40; dragon:4 marble 0.58 0.47 0.47, potato 0.24 0.22
+// 0.21, ketchup 0.79 0.55 0.65; mean ratio 0.80-1.05. What remains is per-texel noise of the
+// M-point estimate (the heavy e^(sigma* r) weights of the far strata; ketchup's short green and
+// blue profiles under a disc shaped by its long red one suffer most), the 64-texel maps (the
+// dragon's thin parts are a few texels wide) and the reference's own noise (80,000 samples). The
+// bounds are the worst measured case per mesh and material plus 30%: the maps are deterministic
+// for one driver (Halton points, hashed rotations) and the reference for one seed, so the margin is
+// for other drivers' rounding, while a wrong weight, visibility or blur moves the error by factors.
+// The first frame's error (mip level 2 blur) is 1.7-5: one point per stratum is a noisy estimate;
+// T frames bring it down 2.4-12 fold (required: at least 2).
+struct AccuracyCase {
+  const char* material;
+  double bound;  // relative RMSE after T frames, strata
+};
+
+void check_accuracy_against_reference(const std::string& mesh,
+                                      const std::vector<AccuracyCase>& cases) {
+  for (const AccuracyCase& c : cases) {
     for (const std::string lights : {"directional", "point", "both"}) {
-      Scene scene = sphere_scene(40, c.material);
-      scene.lights.clear();
+      Scene scene;
+      scene.mesh = load_mesh(mesh, 100);
+      scene.material = materials::load_material(c.material);
       if (lights != "point") scene.lights.push_back(parse_light("directional:1,0.5,0.5:1,1,1"));
       if (lights != "directional")
         scene.lights.push_back(parse_light("point:-60,60,80:5000,5000,5000"));
-      const RenderSettings settings = tiny_settings(T);
+      scene.camera = orbit_camera(scene.mesh, 0, 0, 3.4f, 40, 40);
       ReferenceOptions reference_options;
       reference_options.surface_samples = 20000;
+      reference_options.passes = 4;
       reference_options.threads = 2;
-      const ReferenceImage reference = render_reference(scene, settings.model, reference_options);
+      const ReferenceImage reference =
+          render_reference(scene, DiffusionModel::kDirectionalDipole, reference_options);
       const double mean = masked_mean(reference.image, reference.mask);
       ASSERT_GT(mean, 0.0);
+      const auto error = [&](const ImageRgb& image) {
+        return masked_rmse(image, reference.image, reference.mask) / mean;
+      };
 
-      RadianceMapRenderer renderer;
-      renderer.setup(scene, settings);
-      renderer.render_frame();
-      const double first =
-          masked_rmse(renderer.read_image(), reference.image, reference.mask) / mean;
-      while (renderer.render_frame()) {
+      RenderSettings settings;
+      settings.directions = 8;
+      settings.samples = 16;
+      settings.radiance_map_size = 64;
+      settings.light_map_size = 64;
+
+      // The seed's N nearest of M.
+      settings.disc_selection = DiscSelection::kNearest;
+      settings.disc_points = 1000;
+      settings.frames = 4;
+      RadianceMapRenderer nearest;
+      nearest.setup(scene, settings);
+      while (nearest.render_frame()) {
       }
-      const ImageRgb image = renderer.read_image();
-      const double last = masked_rmse(image, reference.image, reference.mask) / mean;
+      const ImageRgb nearest_image = nearest.read_image();
+      const double nearest_error = error(nearest_image);
+      const double nearest_ratio = masked_mean(nearest_image, reference.mask) / mean;
+
+      // Strata.
+      settings.disc_selection = DiscSelection::kStrata;
+      settings.disc_points = 128;
+      settings.frames = 16;
+      RadianceMapRenderer strata;
+      strata.setup(scene, settings);
+      strata.render_frame();
+      const double first = error(strata.read_image());
+      while (strata.render_frame()) {
+      }
+      const ImageRgb image = strata.read_image();
+      const double last = error(image);
       const double ratio = masked_mean(image, reference.mask) / mean;
       std::printf(
-          "%-8s %-11s relative RMSE: 1 frame %.3f, %d frames %.3f; mean maps/reference %.3f\n",
-          c.material, lights.c_str(), first, T, last, ratio);
-      EXPECT_LT(first, c.bound) << c.material << " " << lights;
-      EXPECT_LT(last, c.bound) << c.material << " " << lights;
-      EXPECT_LT(last, first + 0.05) << c.material << " " << lights;
-      EXPECT_GT(ratio, 0.3) << c.material << " " << lights;
-      EXPECT_LT(ratio, 1.5) << c.material << " " << lights;
+          "%-9s %-8s %-11s relative RMSE: nearest %.3f (mean ratio %.3f); strata 1 frame %.3f, "
+          "16 frames %.3f (mean ratio %.3f)\n",
+          mesh.c_str(), c.material, lights.c_str(), nearest_error, nearest_ratio, first, last,
+          ratio);
+      const std::string what = mesh + " " + c.material + " " + lights;
+      EXPECT_GT(nearest_ratio, 0.3) << what;
+      EXPECT_LT(nearest_ratio, 0.8) << what;
+      EXPECT_LT(last, c.bound) << what;
+      EXPECT_LT(last, first / 2) << what;
+      EXPECT_LT(last, nearest_error) << what;
+      EXPECT_GT(ratio, 0.7) << what;
+      EXPECT_LT(ratio, 1.25) << what;
     }
   }
+}
+
+TEST_F(RadianceMapsTest, ErrorAgainstTheCpuReferenceOnASphere) {
+  check_accuracy_against_reference("sphere",
+                                   {{"marble", 0.43}, {"potato", 0.16}, {"ketchup", 0.66}});
+}
+
+TEST_F(RadianceMapsTest, ErrorAgainstTheCpuReferenceOnTheCoarseDragon) {
+  check_accuracy_against_reference("dragon:4",
+                                   {{"marble", 0.75}, {"potato", 0.32}, {"ketchup", 1.03}});
+}
+
+// Invariant: a medium that absorbs nothing (sigma_tr = 0: the disc is uniform, sigma* = 0, and the
+// profile decays only as a power of r), lit from all six axis directions at once: every pixel is
+// finite and non-negative, and the object is lit all round.
+TEST_F(RadianceMapsTest, ZeroAbsorptionLitFromEverySideIsFiniteAndNonNegative) {
+  for (auto model : {DiffusionModel::kDirectionalDipole, DiffusionModel::kDipole}) {
+    Scene scene = sphere_scene(32);
+    scene.material.sigma_a = {0, 0, 0};
+    scene.material.sigma_s.reset();
+    scene.material.g.reset();
+    scene.lights.clear();
+    for (const char* d : {"1,0,0", "-1,0,0", "0,1,0", "0,-1,0", "0,0,1", "0,0,-1"}) {
+      scene.lights.push_back(parse_light(std::string("directional:") + d + ":1,1,1"));
+    }
+    RenderSettings settings = tiny_settings(4);
+    settings.model = model;
+    RadianceMapRenderer renderer;
+    renderer.setup(scene, settings);
+    EXPECT_EQ(renderer.stats().sigma_star_per_mm, 0.0);
+    while (renderer.render_frame()) {
+    }
+    const ImageRgb image = renderer.read_image();
+    const std::vector<std::uint8_t> mask = renderer.read_mask();
+    long object = 0, dark = 0;
+    for (int y = 0; y < image.height; ++y) {
+      for (int x = 0; x < image.width; ++x) {
+        for (int c = 0; c < 3; ++c) {
+          const float v = image.at(x, y, c);
+          ASSERT_TRUE(std::isfinite(v)) << x << "," << y;
+          ASSERT_GE(v, 0.0f) << x << "," << y;
+        }
+        if (!mask[std::size_t(y) * image.width + x]) continue;
+        ++object;
+        if (image.at(x, y, 1) <= 0) ++dark;
+      }
+    }
+    EXPECT_GT(object, 300);
+    EXPECT_LT(dark, object / 50) << materials::to_string(model);  // lit from every side
+  }
+}
+
+// Invariant: turning the mesh, the light and the camera together leaves the image unchanged up to
+// sampling (the K radiance-map directions stay fixed in the world, so the turned mesh is sampled
+// by other texels). Dragon:4 turned 90 degrees about y, converged strata maps: measured relative
+// RMSE between the two images 0.215 (potato: two independent samplings of one scene; the maps'
+// error against the reference on this mesh is 0.21-0.24); bound 0.3. The same turn with the light
+// left behind must differ by at least twice the bound (it shows the test can see a light or layer
+// direction that does not turn with the scene).
+TEST_F(RadianceMapsTest, TurningMeshLightAndCameraTogetherKeepsTheImage) {
+  Scene scene;
+  scene.mesh = load_mesh("dragon:4", 100);
+  scene.material = materials::load_material("potato");
+  scene.lights = {parse_light("directional:1,0.6,0.4:1,1,1")};
+  scene.camera = orbit_camera(scene.mesh, 20, 15, 3.4f, 48, 48);
+  RenderSettings settings = tiny_settings(16);
+  settings.disc_points = 128;
+  const auto render = [&](const Scene& s) {
+    RadianceMapRenderer renderer;
+    renderer.setup(s, settings);
+    while (renderer.render_frame()) {
+    }
+    return std::make_pair(renderer.read_image(), renderer.read_mask());
+  };
+  const auto [image, mask] = render(scene);
+
+  const Eigen::Matrix3f turn = Eigen::AngleAxisf(std::numbers::pi_v<float> / 2, Vec3f::UnitY())
+                                   .toRotationMatrix();
+  Scene turned = scene;
+  for (Vec3f& p : turned.mesh.positions) p = turn * p;
+  for (Vec3f& n : turned.mesh.normals) n = turn * n;
+  turned.lights[0].direction = turn * scene.lights[0].direction;
+  turned.camera.eye = turn * scene.camera.eye;
+  turned.camera.target = turn * scene.camera.target;
+  turned.camera.up = turn * scene.camera.up;
+  const auto [turned_image, turned_mask] = render(turned);
+
+  long same = 0, object = 0;
+  for (std::size_t i = 0; i < mask.size(); ++i) {
+    object += mask[i];
+    same += mask[i] && turned_mask[i];
+  }
+  EXPECT_GT(same, object * 97 / 100);  // the same silhouette
+  const double mean = masked_mean(image, mask);
+  const double difference = masked_rmse(turned_image, image, mask) / mean;
+  std::printf("turned 90 degrees: relative RMSE %.3f, mean ratio %.3f\n", difference,
+              masked_mean(turned_image, mask) / mean);
+  EXPECT_LT(difference, 0.3);
+  EXPECT_NEAR(masked_mean(turned_image, mask) / mean, 1.0, 0.1);
+
+  turned.lights = scene.lights;
+  const double left_behind = masked_rmse(render(turned).first, image, mask) / mean;
+  std::printf("light left behind: relative RMSE %.3f\n", left_behind);
+  EXPECT_GT(left_behind, 0.6);
 }
 
 // With the whole disc (N = M) and new radii each frame (RadianceMapOptions::new_radii_each_frame,
@@ -352,6 +501,7 @@ TEST_F(RadianceMapsTest, NewRadiiEachFrameConvergeTowardTheReference) {
   reference_options.threads = 2;
   const ReferenceImage reference = render_reference(scene, settings.model, reference_options);
   const double mean = masked_mean(reference.image, reference.mask);
+  settings.disc_selection = DiscSelection::kNearest;  // N = M: all points, new radii each frame
   RadianceMapOptions options;
   options.new_radii_each_frame = true;
   RadianceMapRenderer renderer;
