@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <unistd.h>
 #include <filesystem>
 #include <string>
 
@@ -61,6 +62,10 @@ long differing_pixels(const Shot& a, const Shot& b) {
   return n;
 }
 
+// xvfb-run -a probes for a free display from -n on; tests that ctest runs side by side start from
+// different numbers so that two of them do not claim the same one at the same moment.
+std::string server_number() { return std::to_string(100 + ::getpid() % 800); }
+
 class ViewCommand : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -73,8 +78,8 @@ class ViewCommand : public ::testing::Test {
   // Runs `lucent view ARGS` in dir_ under a fresh virtual X server.
   CommandResult view(const std::string& args, const std::string& before = "") {
     const std::string command = "cd \"" + dir_.string() + "\" || exit 1; " + before +
-                                "MESA_SHADER_CACHE_DISABLE=true xvfb-run -a -s '-screen 0 "
-                                "640x480x24' \"" LUCENT_BINARY "\" view " + args;
+                                "MESA_SHADER_CACHE_DISABLE=true xvfb-run -a -n " + server_number() +
+                                " -s '-screen 0 640x480x24' \"" LUCENT_BINARY "\" view " + args;
     const fs::path out = dir_ / "stdout", err = dir_ / "stderr";
     const int status =
         std::system((command + " >\"" + out.string() + "\" 2>\"" + err.string() + "\"").c_str());
