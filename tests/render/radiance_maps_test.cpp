@@ -12,12 +12,16 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <unistd.h>
+#include <filesystem>
 #include <memory>
 #include <numbers>
 #include <string>
 #include <vector>
 
+#include "lucent/acquire/image_io.h"
 #include "lucent/materials/error.h"
+#include "lucent/materials/fresnel.h"
 #include "lucent/materials/material.h"
 #include "lucent/render/gl_context.h"
 #include "lucent/render/radiance_maps.h"
@@ -483,6 +487,51 @@ TEST_F(RadianceMapsTest, TurningMeshLightAndCameraTogetherKeepsTheImage) {
   const double left_behind = masked_rmse(render(turned).first, image, mask) / mean;
   std::printf("light left behind: relative RMSE %.3f\n", left_behind);
   EXPECT_GT(left_behind, 0.6);
+}
+
+// The final pass's environment term: with a uniform white environment the image gains
+// F_r(eta, n . w_o) everywhere on the object (exact Fresnel of the material's ior: about 0.04 where
+// the surface faces the camera, growing toward the silhouette), and the background shows the map.
+TEST_F(RadianceMapsTest, EnvironmentReflectionAddsTheFresnelWeightedMap) {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("lucent-env-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  ImageRgb white(32, 16);
+  std::fill(white.data.begin(), white.data.end(), 1.0f);
+  acquire::write_exr(dir / "white.exr", white);
+  Scene scene = sphere_scene(41);
+  scene.environment = dir / "white.exr";
+  const RenderSettings settings = tiny_settings(2);
+  const auto render = [&](bool reflection) {
+    RadianceMapOptions options;
+    options.environment_reflection = reflection;
+    RadianceMapRenderer renderer;
+    renderer.setup(scene, settings, options);
+    while (renderer.render_frame()) {
+    }
+    return renderer.read_image();
+  };
+  const ImageRgb with = render(true), without = render(false);
+  std::filesystem::remove_all(dir);
+  // Background: the map itself (white), with or without the reflection term.
+  EXPECT_NEAR(with.at(0, 0, 1), 1.0f, 1e-4f);
+  EXPECT_NEAR(without.at(0, 0, 1), 1.0f, 1e-4f);
+  // Centre pixel: the camera looks straight at the surface, normal incidence.
+  const float eta = float(scene.material.ior);
+  const float centre = with.at(20, 20, 1) - without.at(20, 20, 1);
+  EXPECT_NEAR(centre, materials::fresnel_reflectance(1.0f, eta), 0.1f * centre);
+  // Toward the silhouette the reflection grows (grazing incidence).
+  float rim = 0;
+  for (int x = 0; x < 20; ++x) {
+    const float d = with.at(x, 20, 1) - without.at(x, 20, 1);
+    if (without.at(x, 20, 1) != 1.0f) rim = std::max(rim, d);  // object pixels only
+  }
+  EXPECT_GT(rim, 2 * centre);
+  std::printf("environment reflection: centre %.4f (F_r(1, %.2f) = %.4f), rim %.4f\n", centre, eta,
+              materials::fresnel_reflectance(1.0f, eta), rim);
+  for (std::size_t i = 0; i < with.data.size(); ++i) {
+    ASSERT_GE(with.data[i] - without.data[i], -1e-5f) << i;
+  }
 }
 
 // With the whole disc (N = M) and new radii each frame (RadianceMapOptions::new_radii_each_frame,
