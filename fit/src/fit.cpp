@@ -480,7 +480,6 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
     p.ab[c] = {std::log(start[c].sigma_a), std::log(start[c].sigma_s_reduced)};
   }
   ceres::Problem problem;
-  const bool shared_free = relative || options.fit_ior;
   std::array<int, 3> samples{};
   std::vector<std::pair<int, int>> block_channels;  // (channel, residuals) in insertion order
   std::vector<std::pair<double*, std::string>> calibration_blocks;

@@ -11,7 +11,7 @@ namespace lucent::render {
 
 int run_render_bench(const RenderBenchOptions& options, std::ostream& log) {
   std::ostringstream csv;
-  csv << "mesh,triangles,K,W_s,W_l,N,M,frames,size_px,light_map_ms,radiance_map_ms,mip_blur_ms,"
+  csv << "mesh,triangles,K,W_s,W_l,N,M,disc,frames,size_px,light_map_ms,radiance_map_ms,mip_blur_ms,"
          "final_ms,frame_ms,setup_ms,device\n";
   RenderSettings settings = options.settings;
   settings.frames = options.frames;
@@ -36,7 +36,8 @@ int run_render_bench(const RenderBenchOptions& options, std::ostream& log) {
     const std::string device = stats.details.value("gl_renderer", std::string("unknown"));
     csv << name << ',' << scene.mesh.triangles.size() << ',' << settings.directions << ','
         << settings.radiance_map_size << ',' << settings.light_map_size << ',' << settings.samples << ','
-        << settings.disc_points << ',' << settings.frames << ',' << options.size << ',' << stage[0] << ','
+        << settings.disc_points << ',' << to_string(settings.disc_selection) << ','
+        << settings.frames << ',' << options.size << ',' << stage[0] << ','
         << stage[1] << ',' << stage[2] << ',' << stage[3] << ',' << stage[0] + stage[1] + stage[2] + stage[3]
         << ',' << setup << ",\"" << device << "\"\n";
     log << "  " << name << " (" << scene.mesh.triangles.size() << " triangles): light map " << stage[0]

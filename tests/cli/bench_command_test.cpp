@@ -18,8 +18,8 @@ TEST(BenchCommand, RenderWritesOneRowOfStageTimesPerMesh) {
   if (r.exit_code != 0 && r.err.find("EGL") != std::string::npos) GTEST_SKIP() << r.err;
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string text = read_text(csv);
-  EXPECT_EQ(text.rfind("mesh,triangles,K,W_s,W_l,N,M,frames,size_px,light_map_ms,radiance_map_ms,", 0), 0u);
-  EXPECT_NE(text.find("\nsphere,5120,2,32,32,4,64,1,32,"), std::string::npos) << text;
+  EXPECT_EQ(text.rfind("mesh,triangles,K,W_s,W_l,N,M,disc,frames,size_px,light_map_ms,radiance_map_ms,", 0), 0u);
+  EXPECT_NE(text.find("\nsphere,5120,2,32,32,4,64,strata,1,32,"), std::string::npos) << text;
   fs::remove_all(dir);
 }
 
