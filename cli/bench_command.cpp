@@ -48,7 +48,15 @@ void register_bench_command(CLI::App& app) {
   render_cmd->add_option("--disc-points", rs.disc_points, "M")->capture_default_str();
   render_cmd->add_option("--radiance-map", rs.radiance_map_size, "W_s, texels")->capture_default_str();
   render_cmd->add_option("--light-map", rs.light_map_size, "W_l, texels")->capture_default_str();
-  render_cmd->callback([render_options] {
+  auto selections = std::make_shared<std::vector<std::string>>(
+      std::vector<std::string>{"strata", "nearest"});
+  render_cmd->add_option("--disc-selection", *selections, "disc selections to time (rows each)")
+      ->capture_default_str();
+  render_cmd->callback([render_options, selections] {
+    render_options->disc_selections.clear();
+    for (const auto& text : *selections) {
+      render_options->disc_selections.push_back(render::parse_disc_selection(text));
+    }
     const int n = render::run_render_bench(*render_options, std::cout);
     std::cout << "bench render: " << n << " meshes; wrote " << render_options->out_csv.string()
               << "\n";

@@ -546,12 +546,14 @@ void Viewer::set_parameter(const std::string& name, const std::string& value) {
   if (name == "technique") return set_technique(value);
   if (name == "disc") {
     settings_.disc_selection = pending_.disc_selection = parse_disc_selection(value);
-    return rebuild_maps();
+    return rebuild_maps();  // the reference does not use the disc
   }
   if (name == "model") {
     settings_.model = materials::parse_diffusion_model(value, "--script set model");
     pending_ = settings_;
-    return rebuild_maps();
+    model_from_material_ = false;
+    rebuild_maps();
+    return scene_changed();  // the reference uses the model too
   }
   const float v = parse_float(value, "set " + name);
   if (name == "exposure") {

@@ -20,6 +20,7 @@ TEST(BenchCommand, RenderWritesOneRowOfStageTimesPerMesh) {
   const std::string text = read_text(csv);
   EXPECT_EQ(text.rfind("mesh,triangles,K,W_s,W_l,N,M,disc,frames,size_px,light_map_ms,radiance_map_ms,", 0), 0u);
   EXPECT_NE(text.find("\nsphere,5120,2,32,32,4,64,strata,1,32,"), std::string::npos) << text;
+  EXPECT_NE(text.find("\nsphere,5120,2,32,32,4,64,nearest,1,32,"), std::string::npos) << text;
   fs::remove_all(dir);
 }
 

@@ -15,12 +15,15 @@ struct RenderBenchOptions {
   std::filesystem::path out_csv = "notebooks_data/bench/render.csv";
   std::vector<std::string> meshes = {"bunny", "dragon:4", "dragon:3", "dragon:2"};
   RenderSettings settings;   ///< defaults: the seed's K = 16, W_s = W_l = 512, N = 50, M = 1000
+  /// One row per mesh and selection: strata gathers far disc points, whose scattered light-map
+  /// reads cost more than the seed's nearest ones.
+  std::vector<DiscSelection> disc_selections = {DiscSelection::kStrata, DiscSelection::kNearest};
   int frames = 3;            ///< frames timed per mesh (per-stage means); few on llvmpipe
   int size = 512;            ///< output image, pixels square
   std::string material = "marble";
 };
 
-/// Renders each mesh and appends one row per mesh; returns the rows written.
+/// Renders each mesh with each disc selection, one row each; returns the rows written.
 int run_render_bench(const RenderBenchOptions& options, std::ostream& log);
 
 }  // namespace lucent::render
