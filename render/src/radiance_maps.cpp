@@ -133,6 +133,7 @@ struct RadianceMapRenderer::Impl {
   bool has_environment = false;
 
   std::vector<detail::LayerCamera> layer_cams, light_cams;
+  detail::DiscPoints disc_points;  // drawn by upload_lights
   detail::DiscSamples disc;
 
   std::array<gl::Query, kStageCount> queries;
@@ -151,7 +152,7 @@ struct RadianceMapRenderer::Impl {
   void build_final();
   void upload_lights();
   void upload_material();
-  void upload_disc(int t);
+  void upload_disc(int t, bool redraw);
   void upload_layers();
   void render_light_map();
   void render_radiance_depth();
@@ -451,18 +452,21 @@ void RadianceMapRenderer::Impl::upload_lights() {
   glProgramUniform3fv(p, radiance_program.location("u_light_radiance"), kMaxLights,
                       radiance_.data());
 
-  upload_disc(1);
+  upload_disc(1, true);
 }
 
-void RadianceMapRenderer::Impl::upload_disc(int t) {
+void RadianceMapRenderer::Impl::upload_disc(int t, bool redraw) {
   // The disc: radius of the mesh's bounding box diagonal (seed §5.3.4.1: "a radius equal to the
   // size of the bounding box"), shared round-robin by the lights.
-  const double box = (scene.mesh.bounds_max() - scene.mesh.bounds_min()).norm();
-  disc = detail::exponential_disc_samples(settings.disc_points, settings.samples,
-                                          detail::sigma_star(scene.material, settings.q), box, L,
-                                          options.new_radii_each_frame ? detail::frame_shift(t)
-                                                                       : Eigen::Vector3d::Zero(),
-                                          settings.disc_selection, t);
+  // Drawing the M points is the costly part (tens of ms): only when the material, mesh or lights
+  // changed (upload_lights) or when every frame has new radii.
+  if (redraw || options.new_radii_each_frame) {
+    const double box = (scene.mesh.bounds_max() - scene.mesh.bounds_min()).norm();
+    disc_points = detail::exponential_disc_points(
+        settings.disc_points, detail::sigma_star(scene.material, settings.q), box,
+        options.new_radii_each_frame ? detail::frame_shift(t) : Eigen::Vector3d::Zero());
+  }
+  disc = detail::select_disc_samples(disc_points, settings.samples, L, settings.disc_selection, t);
   std::vector<float> packed(std::size_t(settings.samples) * 4, 0.0f);
   for (std::size_t i = 0; i < disc.samples.size(); ++i) {
     packed[i * 4 + 0] = disc.samples[i].x_mm;
@@ -556,7 +560,7 @@ void RadianceMapRenderer::Impl::render_radiance() {
   const int t = frame;
   const int target = t % 2, previous = 1 - target;
   if (options.new_radii_each_frame || settings.disc_selection == DiscSelection::kStrata) {
-    upload_disc(t);
+    upload_disc(t, false);
   }
   const int W = settings.radiance_map_size;
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, radiance_fbo[target].id());

@@ -56,24 +56,15 @@ Eigen::Vector3d frame_shift(int t) {
   return s;
 }
 
-DiscSamples exponential_disc_samples(int M, int N, double sigma_star_per_mm, double disc_radius_mm,
-                                     int lights, const Eigen::Vector3d& shift,
-                                     DiscSelection selection, int frame) {
-  if (M < 1 || N < 1 || N > M) {
-    throw Error("--samples/--disc-points: need 1 <= N <= M, got N=" + std::to_string(N) +
-                ", M=" + std::to_string(M));
-  }
-  if (lights < 1) throw Error("radiance maps: the scene has no lights");
-  DiscSamples out;
+DiscPoints exponential_disc_points(int M, double sigma_star_per_mm, double disc_radius_mm,
+                                  const Eigen::Vector3d& shift) {
+  if (M < 1) throw Error("--disc-points: need M >= 1, got " + std::to_string(M));
+  DiscPoints out;
   out.sigma_star_per_mm = sigma_star_per_mm;
   double R = disc_radius_mm;
   if (sigma_star_per_mm > 0) R = std::min(R, 30.0 / sigma_star_per_mm);
   out.disc_radius_mm = R;
-
-  struct Point {
-    double x, y, r;
-  };
-  std::vector<Point> kept;
+  std::vector<DiscPoints::Point>& kept = out.points;
   kept.reserve(std::size_t(M));
   for (unsigned n = 1; int(kept.size()) < M; ++n) {
     const auto wrap = [](double v) { return v - std::floor(v); };
@@ -88,7 +79,24 @@ DiscSamples exponential_disc_samples(int M, int N, double sigma_star_per_mm, dou
     }
   }
   std::stable_sort(kept.begin(), kept.end(),
-                   [](const Point& a, const Point& b) { return a.r < b.r; });
+                   [](const DiscPoints::Point& a, const DiscPoints::Point& b) { return a.r < b.r; });
+  return out;
+}
+
+DiscSamples select_disc_samples(const DiscPoints& disc, int N, int lights, DiscSelection selection,
+                                int frame) {
+  const int M = int(disc.points.size());
+  if (M < 1 || N < 1 || N > M) {
+    throw Error("--samples/--disc-points: need 1 <= N <= M, got N=" + std::to_string(N) +
+                ", M=" + std::to_string(M));
+  }
+  if (lights < 1) throw Error("radiance maps: the scene has no lights");
+  DiscSamples out;
+  out.sigma_star_per_mm = disc.sigma_star_per_mm;
+  out.disc_radius_mm = disc.disc_radius_mm;
+  out.candidates = disc.candidates;
+  const double R = disc.disc_radius_mm, sigma_star_per_mm = disc.sigma_star_per_mm;
+  const std::vector<DiscPoints::Point>& kept = disc.points;
   const bool strata = selection == DiscSelection::kStrata;
   out.used_radius_mm =
       N < M && !strata ? 0.5 * (kept[std::size_t(N) - 1].r + kept[std::size_t(N)].r) : R;
@@ -103,7 +111,7 @@ DiscSamples exponential_disc_samples(int M, int N, double sigma_star_per_mm, dou
   // The N points of this frame and how many of the M each stands for.
   const int L = std::min(lights, N);
   const int t = std::max(frame, 1) - 1;
-  std::vector<std::pair<const Point*, double>> chosen;
+  std::vector<std::pair<const DiscPoints::Point*, double>> chosen;
   for (int i = 0; i < N; ++i) {
     if (!strata) {
       chosen.emplace_back(&kept[std::size_t(i)], 1.0);
@@ -132,6 +140,13 @@ DiscSamples exponential_disc_samples(int M, int N, double sigma_star_per_mm, dou
     out.light_count.push_back(int(out.samples.size()) - out.light_offset.back());
   }
   return out;
+}
+
+DiscSamples exponential_disc_samples(int M, int N, double sigma_star_per_mm, double disc_radius_mm,
+                                     int lights, const Eigen::Vector3d& shift,
+                                     DiscSelection selection, int frame) {
+  return select_disc_samples(exponential_disc_points(M, sigma_star_per_mm, disc_radius_mm, shift),
+                             N, lights, selection, frame);
 }
 
 namespace {

@@ -43,6 +43,24 @@ struct DiscSamples {
   std::string to_string() const;
 };
 
+/// The M points of the disc, sorted by radius (see exponential_disc_samples). Drawing them is the
+/// expensive part (rejection: up to ~450,000 Halton candidates for M = 1000 when sigma* R is large,
+/// tens of ms), so the renderer draws them once per material, disc and lights and only re-selects
+/// per frame.
+struct DiscPoints {
+  struct Point {
+    double x, y, r;  ///< mm
+  };
+  std::vector<Point> points;
+  double sigma_star_per_mm = 0, disc_radius_mm = 0;
+  long candidates = 0;
+};
+DiscPoints exponential_disc_points(int M, double sigma_star_per_mm, double disc_radius_mm,
+                                   const Eigen::Vector3d& shift = Eigen::Vector3d::Zero());
+/// This frame's N of the points and their weights (see exponential_disc_samples).
+DiscSamples select_disc_samples(const DiscPoints& disc, int N, int lights,
+                                DiscSelection selection = DiscSelection::kNearest, int frame = 1);
+
 /// The disc of seed §5.3.4.1: M Halton points (bases 2, 3) uniform on the disc of radius R (mapped
 /// by r = R sqrt(s), which is area-uniform; the seed's "project the sphere point" is not, its
 /// density grows toward the rim), each kept with probability e^(-sigma* r) (rejection against a

@@ -410,11 +410,6 @@ void Viewer::frame() {
   ++frames_drawn_;
   // Screenshots read the back buffer before the swap.
   if (!screenshot_path_.empty()) screenshot(std::exchange(screenshot_path_, {}));
-  if (!ImGui::GetIO().WantCaptureKeyboard &&
-      std::find(keys_.begin(), keys_.end(), GLFW_KEY_S) != keys_.end()) {
-    screenshot(next_screenshot_path());
-  }
-  keys_.clear();
   glfwSwapBuffers(window_);
 }
 
@@ -465,11 +460,13 @@ void Viewer::run_script_step() {
 }
 
 void Viewer::handle_keys() {
+  const std::vector<int> keys = std::exchange(keys_, {});
   if (ImGui::GetIO().WantCaptureKeyboard) return;
-  for (int key : keys_) {
+  for (int key : keys) {
     if (key == GLFW_KEY_ESCAPE) quit_ = true;
     if (key == GLFW_KEY_H) show_ui_ = !show_ui_;
     if (key == GLFW_KEY_R) scene_changed();
+    if (key == GLFW_KEY_S) screenshot_path_ = next_screenshot_path();  // taken after drawing
   }
 }
 
