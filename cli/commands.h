@@ -13,5 +13,6 @@ void register_fit_command(CLI::App& app);
 void register_bench_command(CLI::App& app);
 void register_render_command(CLI::App& app);
 void register_view_command(CLI::App& app);
+void register_tabulate_command(CLI::App& app);
 
 }  // namespace lucent::cli

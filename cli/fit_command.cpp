@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "commands.h"
+#include "lucent/materials/transport_table.h"
 #include "lucent/fit/fit.h"
 #include "lucent/fit/fit_plot.h"
 #include "lucent/materials/atomic_file.h"
@@ -21,6 +22,8 @@ struct FitArguments {
   std::string plot, report, name;
   double exclude_radius_mm = -1;
   double ior = 0;
+  double g = 0;
+  std::string table;
   bool fit_ior = false, relative = false, json = false, allow_unconverged = false;
 };
 
@@ -30,10 +33,14 @@ fit::FitOptions to_options(const FitArguments& a) {
     o.model = fit::FitModel::kDipole;
   else if (a.model == "ddipole")
     o.model = fit::FitModel::kDirectionalDipole;
+  else if (a.model == "tabulated")
+    o.model = fit::FitModel::kTabulated;
   else if (a.model == "auto")
     o.model = fit::FitModel::kAuto;
   else
-    throw Error("--model: expected dipole, ddipole or auto, got '" + a.model + "'");
+    throw Error("--model: expected auto, tabulated, dipole or ddipole, got '" + a.model + "'");
+  if (!(a.g >= 0 && a.g <= 0.95)) throw Error("--g: expected a Henyey-Greenstein g in [0, 0.95]");
+  o.g = a.g;
   if (a.quality == "fast")
     o.quality = fit::Quality::kFast;
   else if (a.quality == "balanced")
@@ -78,10 +85,15 @@ void run(const FitArguments& a) {
   std::vector<fit::ProfileData> data;
   for (const std::string& input : a.inputs) {
     data.push_back(fit::load_profile_data(input));
-    const bool csv = input.size() > 4 && input.substr(input.size() - 4) == ".csv";
-    if (csv && !options.ior && !options.fit_ior) {
-      throw Error("--ior: required with a CSV profile (" + input + "), which carries no index");
+    if (!data.back().eta && !options.ior && !options.fit_ior) {
+      throw Error("--ior: required with " + input + ", which carries no index (no ior= or eta= "
+                  "in its comment lines)");
     }
+  }
+  materials::TransportTable table;
+  if (!a.table.empty()) {
+    table = materials::read_transport_table(a.table);
+    options.table = &table;
   }
   const fit::FitResult result = fit::fit_profiles(data, options);
   std::string name = a.name;
@@ -102,17 +114,31 @@ void run(const FitArguments& a) {
     return;
   }
   const char* names[3] = {"R", "G", "B"};
-  std::cout << "fitted "
-            << (f.model == fit::FitModel::kDipole ? "standard dipole" : "directional dipole")
-            << " (" << result.reason << ")\n";
+  std::cout << "fitted " << fit::to_string(f.model) << " (" << result.reason << ")\n";
   for (int c = 0; c < 3; ++c) {
-    if (f.channels[c].samples == 0) continue;
-    std::cout << "  " << names[c] << ": sigma_a = " << f.channels[c].sigma_a << " +- "
-              << f.channels[c].sd_sigma_a << " /mm, sigma_s' = " << f.channels[c].sigma_s_reduced
-              << " +- " << f.channels[c].sd_sigma_s_reduced << " /mm (" << f.channels[c].samples
-              << " samples, rms " << f.channels[c].residual_rms << " SE)\n";
+    const fit::ChannelFit& ch = f.channels[c];
+    if (ch.samples == 0) continue;
+    std::cout << "  " << names[c] << ": sigma_a = " << ch.sigma_a << " +- " << ch.sd_sigma_a
+              << " /mm, sigma_s' = " << ch.sigma_s_reduced << " +- " << ch.sd_sigma_s_reduced
+              << " /mm (total SD; statistical " << ch.sd_stat_sigma_a << ", "
+              << ch.sd_stat_sigma_s_reduced << "; systematic " << ch.sd_sys_sigma_a << ", "
+              << ch.sd_sys_sigma_s_reduced << "), " << ch.samples << " samples over "
+              << ch.exclude_radius_mm << ".." << ch.range_end_mm << " mm, reduced chi^2 "
+              << ch.reduced_chi2 << "\n";
   }
+  if (!result.g_09.empty()) {
+    std::cout << "  assumed g = " << result.g << "; at g = " << result.g_other << " the answer would be:";
+    for (int c = 0; c < 3; ++c) {
+      if (f.channels[c].samples == 0) continue;
+      std::cout << " " << names[c] << " sigma_a " << result.g_09[c][0] << ", sigma_s' "
+                << result.g_09[c][1] << ";";
+    }
+    std::cout << " (radial data cannot tell g from sigma_s)\n";
+  }
+  if (!result.adequate_model.empty())
+    std::cout << "  cheapest adequate model for rendering: " << result.adequate_model << '\n';
   for (const std::string& note : result.notes) std::cout << "  note: " << note << '\n';
+  for (const std::string& w : result.warnings) std::cerr << "lucent fit: warning: " << w << '\n';
   std::cout << "wrote " << a.output << '\n';
 }
 
@@ -122,20 +148,29 @@ void register_fit_command(CLI::App& app) {
   auto args = std::make_shared<FitArguments>();
   CLI::App* cmd =
       app.add_subcommand("fit",
-                         "Fit the standard or directional dipole to measured profiles "
-                         "(lucent-profile JSON from lucent "
-                         "acquire, or CSV with r_mm and R or R_r,R_g,R_b per mm^2 and optional se "
-                         "columns) and write a "
-                         "material file. Several profiles of one material are fitted jointly.");
+                         "Fit optical coefficients to measured profiles (lucent-profile JSON from "
+                         "lucent acquire, or lucent's radial CSV from lucent profile / simulate "
+                         "--exitance-csv) and write a material file. By default the model exact "
+                         "to transport (tabulated) for radial normal-incidence data, with which "
+                         "cheaper model would do. Several profiles of one material are fitted "
+                         "jointly.");
   cmd->add_option("inputs", args->inputs, "profile files (.json or .csv)")->required();
   cmd->add_option("-o,--output", args->output, "material file to write (.json)")->required();
   cmd->add_option("--model", args->model,
-                  "dipole, ddipole or auto (simplest the data does not reject)")
+                  "auto (the accurate model, and which cheaper one is adequate), tabulated, dipole "
+                  "or ddipole")
       ->capture_default_str();
+  cmd->add_option("--g", args->g,
+                  "Henyey-Greenstein g the tabulated model assumes (radial data cannot tell g "
+                  "from sigma_s; the report says how far the answer moves)")
+      ->capture_default_str();
+  cmd->add_option("--table", args->table,
+                  "transport table for the tabulated model (default: the shipped one)");
   cmd->add_option(
       "--exclude-radius-mm", args->exclude_radius_mm,
-      "leave out samples closer to the entry point than this, mm (default: one transport "
-      "mean free path, estimated)");
+      "leave out samples closer to the entry point than this, mm, in every channel (default: "
+      "per channel; tabulated: two pixels or 0.1 mean free path, dipoles: one transport mean "
+      "free path)");
   cmd->add_option("--ior", args->ior,
                   "relative index of refraction of the sample (required with CSV)");
   cmd->add_flag("--fit-ior", args->fit_ior, "fit the index too (one for all channels)");

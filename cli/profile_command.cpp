@@ -18,6 +18,7 @@ struct ProfileArguments {
   std::string radius_range;
   std::string configs;
   bool total = false;
+  std::string quantity = "exitance";
   std::string output;
 };
 
@@ -26,7 +27,7 @@ void run_profile(const ProfileArguments& args) {
   const Material material = load_material(args.material);
   const std::string model_name =
       !args.model.empty() ? args.model : (!material.model.empty() ? material.model : "dipole");
-  const DiffusionModel model = parse_diffusion_model(model_name);
+  const DiffusionModel model = parse_diffusion_model(model_name, "--model", true);
 
   std::string csv;
   if (!args.configs.empty()) {
@@ -37,6 +38,10 @@ void run_profile(const ProfileArguments& args) {
     RadialProfileOptions options;
     options.model = model;
     options.total = args.total;
+    if (args.quantity == "radiance")
+      options.quantity = TableQuantity::kRadiance;
+    else if (args.quantity != "exitance")
+      throw Error("--quantity: expected 'exitance' or 'radiance', got '" + args.quantity + "'");
     options.r_mm =
         !args.radii.empty() ? parse_radius_list(args.radii) : parse_radius_range(args.radius_range);
     csv = radial_profile_csv(material, options);
@@ -54,15 +59,21 @@ void register_profile_command(CLI::App& app) {
   auto args = std::make_shared<ProfileArguments>();
   CLI::App* cmd = app.add_subcommand(
       "profile",
-      "Evaluate a diffusion model and write CSV. Radial mode (--r or --r-range) writes "
-      "r_mm,Rd_r,Rd_g,Rd_b: R_d(r) per mm^2 for unit incident flux (ddipole: pi S_d at normal "
-      "incidence). Configuration mode (--configs) writes S_d per mm^2 per sr for each row.");
+      "Evaluate a model and write CSV. Radial mode (--r or --r-range) writes lucent's radial CSV "
+      "(a '# format=lucent-radial-profile ...' line, then r_mm,R_r,R_g,R_b): per mm^2 per unit "
+      "power entering, normal incidence, the exitance or pi L along the normal (--quantity); it "
+      "feeds lucent fit unchanged. Configuration mode (--configs) writes S_d per mm^2 per sr.");
   cmd->add_option("--material", args->material,
                   "bundled material name (e.g. marble) or path to a lucent-material JSON file")
       ->required();
   cmd->add_option("--model", args->model,
-                  "dipole (standard dipole) or ddipole (directional dipole); default: the "
-                  "material's fitted model, else dipole");
+                  "dipole (standard dipole), ddipole (directional dipole) or tabulated (the "
+                  "Monte Carlo transport table, radial only); default: the material's fitted "
+                  "model, else dipole");
+  cmd->add_option("--quantity", args->quantity,
+                  "radial mode: exitance (R(r), all directions) or radiance (pi L along the "
+                  "normal)")
+      ->capture_default_str();
   auto* r = cmd->add_option("--r", args->radii, "comma-separated radii in mm, e.g. 0.1,0.5,1,2");
   auto* range = cmd->add_option("--r-range", args->radius_range,
                                 "FROM:TO:COUNT[:lin|log] radii in mm, e.g. 0.01:50:200:log");
@@ -73,8 +84,8 @@ void register_profile_command(CLI::App& app) {
   r->excludes(range)->excludes(configs);
   range->excludes(configs);
   cmd->add_flag("--total", args->total,
-                "append a row 'total' with the total diffuse reflectance per channel "
-                "(closed form for dipole, quadrature for ddipole)");
+                "add a line '# total=R,G,B', the total diffuse reflectance per channel "
+                "(closed form for dipole, quadrature for ddipole, the table's for tabulated)");
   cmd->add_option("-o,--output", args->output, "output CSV file (default: standard output)");
   cmd->callback([args, r, range, configs] {
     if (r->count() + range->count() + configs->count() == 0) {

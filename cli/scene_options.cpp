@@ -167,8 +167,7 @@ SceneSetup build_scene(SceneArguments& args) {
   Scene scene;
   scene.material = materials::load_material(args.material);
   const std::string model_name =
-      !args.model.empty() ? args.model
-                          : (!scene.material.model.empty() ? scene.material.model : "ddipole");
+      !args.model.empty() ? args.model : scene.material.diffusion_model("ddipole");
   args.settings.model = materials::parse_diffusion_model(model_name, "--model");
   scene.mesh = load_mesh(args.mesh, args.object_size_mm);
   scene.lights = lights;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/photo.hpp>
 
 #include "lucent/acquire/camera.h"
@@ -320,7 +321,11 @@ HdrResult merge_stack(const Stack& stack, const ResponseCurve& curve,
     for (std::size_t k = 0; k < brackets; ++k) {
       const int v = stack.images[k].data[i];
       all_saturated = all_saturated && v >= top;
-      all_black = all_black && (v == 0 || v <= dark_code);
+      // Black means censored: code 0, below what the sensor can represent. A code at the dark
+      // frame's level is a measurement of (nearly) no light, not a censored one: masking those
+      // would keep only the pixels that noise lifted above the dark level and bias the faint
+      // tail upward (a floor in the profile).
+      all_black = all_black && v == 0;
       const double weight = ramp[v] * stack.exposure_s[k];
       if (weight > 0) {
         sum_w += weight;
@@ -391,6 +396,21 @@ HdrResult merge_stack(const Stack& stack, const ResponseCurve& curve,
   // merged value once, through sum_k w_k / t_k.
   // Quantisation never vanishes for a real curve; the floor (1e-7 of full scale, squared) guards a
   // flat stretch of a recovered (Debevec) curve with no fitted noise against infinite weights.
+  // The first pass averaged over 5 x 5 pixels (valid ones only): the signal the final weights
+  // come from.
+  std::vector<double> smooth_pass(n, 0.0);
+  {
+    std::vector<double> valid(n, 0.0), value(n, 0.0);
+    for (std::size_t i = 0; i < n; ++i)
+      if (result.mask[i] == PixelMask::kValid) valid[i] = 1, value[i] = first_pass[i];
+    cv::Mat v(h, w, CV_64FC3, value.data()), m(h, w, CV_64FC3, valid.data());
+    cv::Mat vs, ms;
+    cv::boxFilter(v, vs, -1, cv::Size(5, 5), cv::Point(-1, -1), false, cv::BORDER_REPLICATE);
+    cv::boxFilter(m, ms, -1, cv::Size(5, 5), cv::Point(-1, -1), false, cv::BORDER_REPLICATE);
+    const double* a = vs.ptr<double>();
+    const double* b = ms.ptr<double>();
+    for (std::size_t i = 0; i < n; ++i) smooth_pass[i] = b[i] > 0 ? a[i] / b[i] : first_pass[i];
+  }
   std::array<double, 3> variance_floor{};
   for (int c = 0; c < 3; ++c)
     variance_floor[c] = std::pow(1e-7 * std::abs(curve.linear[c][m]), 2) + 1e-300;
@@ -401,14 +421,23 @@ HdrResult merge_stack(const Stack& stack, const ResponseCurve& curve,
     const double g = result.noise.gain[c], s = result.noise.read_variance[c];
     const double d = dark ? curve.linear[c][dark->data[i]] : 0.0;
     const double dark_variance = dark ? s + q2[c][dark->data[i]] : 0.0;
-    const double signal = std::max(first_pass[i], 0.0);
+    // The weights use the neighbourhood's signal, not this pixel's: a weight computed from the
+    // pixel's own noisy value correlates with its noise and biases faint pixels upward.
+    const double signal = std::max(smooth_pass[i], 0.0);
     double sum_w = 0, sum_wx = 0, sum_w2v = 0, sum_w2q = 0, sum_w_over_t = 0;
     for (std::size_t k = 0; k < brackets; ++k) {
       const int v = stack.images[k].data[i];
-      if (ramp[v] <= 0) continue;
+      if (v >= top) continue;  // saturated: clipped, no measurement
+      // The weight comes from the code the first-pass signal predicts, not from the observed
+      // code: weights that grow with the observed (noisy) code favour upward fluctuations and
+      // bias faint pixels upward.
       const double t = stack.exposure_s[k];
+      const std::vector<double>& f = curve.linear[c];
+      const int predicted = int(std::lower_bound(f.begin(), f.end(), signal * t + d) - f.begin());
+      if (predicted >= top) continue;  // this bracket is expected to saturate
+      const double hat = ramp[std::size_t(std::max(predicted, 1))];
       const double variance = std::max(g * signal * t + s + q2[c][v], variance_floor[c]) / (t * t);
-      const double weight = from_pairs ? ramp[v] / variance : ramp[v] * t;
+      const double weight = from_pairs ? hat / variance : hat * t;
       sum_w += weight;
       sum_wx += weight * (curve.linear[c][v] - d) / t;
       sum_w2v += weight * weight * variance;

@@ -53,9 +53,18 @@
 
 #include "lucent/materials/error.h"
 #include "lucent/materials/fresnel.h"
+#include "monte_carlo_random.h"
 
 namespace lucent::acquire {
 namespace {
+
+using detail::exponential_ziggurat;
+using detail::ExponentialZiggurat;
+using detail::stream_seed;
+using detail::Xoshiro256StarStar;
+using detail::HenyeyGreenstein;
+using detail::sample_isotropic;
+using detail::scatter_henyey_greenstein;
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kRouletteThreshold = 1e-4;
@@ -70,97 +79,6 @@ constexpr std::size_t kTallyMemoryBudgetBytes = std::size_t(1) << 30;
 constexpr std::uint64_t kMaxPhotons = 1'000'000'000'000'000;
 
 // ---------------------------------------------------------------------------------------------
-// Random numbers: xoshiro256** (Blackman and Vigna 2018), seeded by splitmix64.
-
-std::uint64_t splitmix64_next(std::uint64_t& state) {
-  std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-
-std::uint64_t mix64(std::uint64_t value) {
-  return splitmix64_next(value);
-}
-
-class Xoshiro256StarStar {
- public:
-  explicit Xoshiro256StarStar(std::uint64_t seed) {
-    for (auto& word : s_) word = splitmix64_next(seed);
-  }
-
-  std::uint64_t next() {
-    const std::uint64_t result = rotl(s_[1] * 5, 7) * 9;
-    const std::uint64_t t = s_[1] << 17;
-    s_[2] ^= s_[0];
-    s_[3] ^= s_[1];
-    s_[1] ^= s_[2];
-    s_[0] ^= s_[3];
-    s_[2] ^= t;
-    s_[3] = rotl(s_[3], 45);
-    return result;
-  }
-
-  /// Uniform in [0, 1), 53 random bits.
-  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
-  /// Uniform in (0, 1): safe for log.
-  double uniform_open() { return (static_cast<double>(next() >> 11) + 0.5) * 0x1.0p-53; }
-
- private:
-  static std::uint64_t rotl(std::uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
-  std::uint64_t s_[4];
-};
-
-/// Standard exponential variates by Marsaglia and Tsang's ziggurat (2000), 256 layers of equal area
-/// v under e^-x: ~99% of draws cost one random number, a multiply and a compare, against a log for
-/// inversion (a quarter of the transport time in profiles). Exact: the wedges are sampled by
-/// rejection against e^-x and the tail beyond r by r + Exp(1) (memorylessness).
-class ExponentialZiggurat {
- public:
-  ExponentialZiggurat() {
-    // Layer 0 is the base strip [0, x_0] x [0, e^-r] holding the tail too (x_0 = v / e^-r); layer
-    // i >= 1 is [0, x_i] x [e^-x_i, e^-x_(i+1)], each of area v.
-    constexpr double r = 7.69711747013104972;
-    constexpr double v = 3.949659822581572e-3;
-    x_[0] = v / std::exp(-r);
-    x_[1] = r;
-    for (int i = 1; i < kLayers - 1; ++i) x_[i + 1] = -std::log(v / x_[i] + std::exp(-x_[i]));
-    x_[kLayers] = 0;
-    for (int i = 0; i <= kLayers; ++i) f_[i] = std::exp(-x_[i]);
-  }
-
-  double sample(Xoshiro256StarStar& rng) const {
-    for (;;) {
-      const std::uint64_t bits = rng.next();
-      const auto i = static_cast<int>(bits & (kLayers - 1));  // low 8 bits: the layer
-      // High 53 bits: the position, at the centre of its cell so that x > 0 (an infinite mean free
-      // path, sigma_t = 0, then gives an infinite free path, never 0 * inf).
-      const double u = (static_cast<double>(bits >> 11) + 0.5) * 0x1.0p-53;
-      const double x = u * x_[i];
-      if (x < x_[i + 1]) return x;  // wholly under the curve
-      if (i == 0) return x_[1] - std::log(rng.uniform_open());
-      if (f_[i] + rng.uniform() * (f_[i + 1] - f_[i]) < std::exp(-x)) return x;
-    }
-  }
-
- private:
-  static constexpr int kLayers = 256;
-  double x_[kLayers + 1];
-  double f_[kLayers + 1];
-};
-
-const ExponentialZiggurat& exponential_ziggurat() {
-  static const ExponentialZiggurat table;
-  return table;
-}
-
-std::uint64_t stream_seed(std::uint64_t seed, int channel, std::uint64_t batch) {
-  std::uint64_t h = mix64(seed ^ 0x6c7563656e74ULL);  // "lucent"
-  h = mix64(h + static_cast<std::uint64_t>(channel) + 1);
-  return mix64(h ^ (batch * 0xd1342543de82ef95ULL + 1));
-}
-
-// ---------------------------------------------------------------------------------------------
 // Per-channel constants of the transport.
 
 struct Transport {
@@ -170,7 +88,7 @@ struct Transport {
   double albedo = 0;
   double absorbed_fraction = 1;  // 1 - albedo
   double g = 0;
-  double hg_1_plus_g2 = 1, hg_1_minus_g2 = 1, hg_inv_2g = 0, hg_pdf_scale = 0;
+  HenyeyGreenstein hg;
   double eta_out = 1;  // relative index going out, 1 / eta
   bool finite = false;
   double thickness_mm = 0;
@@ -207,10 +125,7 @@ Transport make_transport(const PhotonTransportOptions& o, int channel,
   t.albedo = t.sigma_t > 0 ? m.sigma_s / t.sigma_t : 0.0;
   t.absorbed_fraction = 1.0 - t.albedo;
   t.g = m.g;
-  t.hg_1_plus_g2 = 1 + m.g * m.g;
-  t.hg_1_minus_g2 = 1 - m.g * m.g;
-  t.hg_inv_2g = m.g != 0 ? 1.0 / (2 * m.g) : 0.0;
-  t.hg_pdf_scale = t.hg_1_minus_g2 / (4 * kPi);
+  t.hg = HenyeyGreenstein(m.g);
   t.eta_out = 1.0 / m.eta;
   t.finite = std::isfinite(o.thickness_mm);
   t.thickness_mm = t.finite ? o.thickness_mm : 0.0;
@@ -329,40 +244,6 @@ struct PhotonScratch {
 // ---------------------------------------------------------------------------------------------
 // The transport kernel.
 
-/// A uniform point (a, b) in the unit disc by rejection from the square, both coordinates from one
-/// 64-bit draw (32 bits each: a resolution of 5e-10, far below anything a direction needs).
-inline double sample_unit_disc(Xoshiro256StarStar& rng, double& a, double& b) {
-  for (;;) {
-    const std::uint64_t bits = rng.next();
-    a = static_cast<double>(static_cast<std::int32_t>(bits >> 32)) * 0x1.0p-31;
-    b = static_cast<double>(static_cast<std::int32_t>(bits & 0xffffffffu)) * 0x1.0p-31;
-    const double r2 = a * a + b * b;
-    if (r2 < 1) return r2;
-  }
-}
-
-/// cos(phi), sin(phi) of a uniform azimuth, from a point in the unit disc (no trigonometry).
-inline void sample_azimuth(Xoshiro256StarStar& rng, double& cos_phi, double& sin_phi) {
-  double a, b, r2;
-  do {
-    r2 = sample_unit_disc(rng, a, b);
-  } while (r2 == 0);
-  const double inv = 1.0 / r2;
-  cos_phi = (a * a - b * b) * inv;
-  sin_phi = 2 * a * b * inv;
-}
-
-/// A uniform direction on the sphere (Marsaglia 1972): from (a, b) uniform in the unit disc with
-/// r2 = a^2 + b^2, (2 a sqrt(1 - r2), 2 b sqrt(1 - r2), 1 - 2 r2). One square root, no division.
-inline void sample_isotropic(Xoshiro256StarStar& rng, double& ux, double& uy, double& uz) {
-  double a, b;
-  const double r2 = sample_unit_disc(rng, a, b);
-  const double scale = 2 * std::sqrt(1 - r2);
-  ux = a * scale;
-  uy = b * scale;
-  uz = 1 - 2 * r2;
-}
-
 template <bool kIsotropic, bool kImage, bool kFinite, bool kSplit>
 void trace_photons(const Transport& t, std::uint64_t photons, Xoshiro256StarStar& rng,
                    PhotonScratch& scratch, Tally& tally) {
@@ -471,9 +352,7 @@ void trace_photons(const Transport& t, std::uint64_t photons, Xoshiro256StarStar
             if constexpr (kIsotropic) {
               phase = 1.0 / (4 * kPi);
             } else {
-              const double denom =
-                  t.hg_1_plus_g2 - 2 * t.g * (ux * t.wt_x + uy * t.wt_y + uz * t.wt_z);
-              phase = t.hg_pdf_scale / (denom * std::sqrt(denom));
+              phase = t.hg.pdf(ux * t.wt_x + uy * t.wt_y + uz * t.wt_z);
             }
             const double v = w * t.nee_factor * phase * std::exp(-tau);
             if (v > 0) {
@@ -503,26 +382,7 @@ void trace_photons(const Transport& t, std::uint64_t photons, Xoshiro256StarStar
       if constexpr (kIsotropic) {
         sample_isotropic(rng, ux, uy, uz);
       } else {
-        double cos_phi, sin_phi;
-        // Henyey-Greenstein inversion (as in MCML), guarded against rounding past +-1.
-        const double tmp = t.hg_1_minus_g2 / (1 - t.g + 2 * t.g * rng.uniform());
-        const double cos_theta = std::clamp((t.hg_1_plus_g2 - tmp * tmp) * t.hg_inv_2g, -1.0, 1.0);
-        const double sin_theta = std::sqrt(std::max(0.0, 1 - cos_theta * cos_theta));
-        sample_azimuth(rng, cos_phi, sin_phi);
-        if (std::abs(uz) > 0.99999) {
-          // Near the pole the general rotation divides by ~0 (MCML's Spin()).
-          ux = sin_theta * cos_phi;
-          uy = sin_theta * sin_phi;
-          uz = uz > 0 ? cos_theta : -cos_theta;
-        } else {
-          const double root = std::sqrt(1 - uz * uz);
-          const double nx = sin_theta * (ux * uz * cos_phi - uy * sin_phi) / root + ux * cos_theta;
-          const double ny = sin_theta * (uy * uz * cos_phi + ux * sin_phi) / root + uy * cos_theta;
-          const double nz = -sin_theta * cos_phi * root + uz * cos_theta;
-          ux = nx;
-          uy = ny;
-          uz = nz;
-        }
+        scatter_henyey_greenstein(t.hg, rng, ux, uy, uz);
       }
     }
 

@@ -13,9 +13,13 @@
 #include <sstream>
 
 #include "dipole_gradient.h"
+#include "fit_start.h"
 #include "lucent/materials/albedo.h"
+#include "lucent/materials/tabulated.h"
+#include "lucent/materials/transport_table.h"
 #include "lucent/materials/error.h"
 #include "lucent/version.h"
+#include "fit_uncertainty.h"
 #include "model_prediction.h"
 
 namespace lucent::fit {
@@ -23,6 +27,8 @@ namespace {
 
 using detail::CaptureGeometry;
 using detail::GaussLegendre;
+using detail::start_values;
+using detail::StartValues;
 
 constexpr double kDegree = std::numbers::pi / 180.0;
 
@@ -34,6 +40,7 @@ CaptureGeometry geometry_of(const ProfileData& d) {
   // The beam travels toward azimuth phi, so the light sits the other way.
   g.w_i = {-std::sin(theta) * std::cos(phi), -std::sin(theta) * std::sin(phi), std::cos(theta)};
   g.exitance = d.exitance;
+  g.per_incident_power = d.per_incident_power;
   return g;
 }
 
@@ -47,6 +54,7 @@ struct Observations {
   double pixel = 0;                // footprint side of the pixels behind the samples, mm
   std::vector<double> log_value;   // log of the measurement
   std::vector<double> inv_rel_se;  // value / standard error: weights the log-ratio
+  std::vector<double> data_rel_se;  // the data's own relative standard error (before the table's)
 };
 
 // Residuals (log model - log data) * value / se: the log-ratio in units of the relative standard
@@ -55,6 +63,7 @@ struct ProfileResiduals {
   const Observations* obs;
   FitModel model;
   GaussLegendre gl;
+  const materials::TabulatedProfile* table = nullptr;  // kTabulated only
 
   template <typename T>
   bool operator()(const T* const ab, const T* const log_scale, const T* const eta,
@@ -68,25 +77,14 @@ struct ProfileResiduals {
     using std::log;
     const materials::Medium<T> medium =
         materials::Medium<T>::from_reduced(exp(ab[0]), exp(ab[1]), eta);
-    const T log_front = log_scale + log(detail::fresnel_factor(
-                                        obs->geometry, eta, model == FitModel::kDirectionalDipole));
+    const T log_front = log_scale + log(detail::fresnel_factor(obs->geometry, eta, model));
     const std::size_t n = obs->log_value.size();
-    if (model == FitModel::kDipole) {
-      const materials::StandardDipole<T> dipole(medium);
-      for (std::size_t i = 0; i < n; ++i) {
-        const T v = obs->radial
-                        ? detail::dipole_annulus(dipole, obs->r[i], obs->r0[i], obs->r1[i], gl)
-                        : detail::dipole_pixel(dipole, obs->x[i], obs->y[i], obs->pixel, gl);
-        residual[i] = (log_front + log(v + T(1e-300)) - obs->log_value[i]) * obs->inv_rel_se[i];
-      }
-    } else {
-      const materials::DirectionalDipole<T> dd(medium);
-      for (std::size_t i = 0; i < n; ++i) {
-        const T v = obs->radial ? detail::ddipole_annulus(dd, obs->r[i], obs->r0[i], obs->r1[i], gl)
-                                : detail::ddipole_pixel(dd, obs->geometry, obs->x[i], obs->y[i],
-                                                        obs->pixel, gl);
-        residual[i] = (log_front + log(v + T(1e-300)) - obs->log_value[i]) * obs->inv_rel_se[i];
-      }
+    for (std::size_t i = 0; i < n; ++i) {
+      const T v = detail::model_value(model, table, medium, obs->geometry, obs->radial,
+                                      obs->radial ? obs->r[i] : 0.0, obs->radial ? obs->r0[i] : 0.0,
+                                      obs->radial ? obs->r1[i] : 0.0, obs->x[i], obs->y[i],
+                                      obs->pixel, gl);
+      residual[i] = (log_front + log(v + T(1e-300)) - obs->log_value[i]) * obs->inv_rel_se[i];
     }
     return true;
   }
@@ -122,7 +120,8 @@ class DipoleRadialCost : public ceres::CostFunction {
     const double* ab = parameters[0];
     const detail::DipoleGradientModel model(std::exp(ab[0]), std::exp(ab[1]), *eta_);
     const double log_front =
-        parameters[1][0] + std::log(detail::fresnel_factor(obs_->geometry, *eta_, false));
+        parameters[1][0] +
+        std::log(detail::fresnel_factor(obs_->geometry, *eta_, FitModel::kDipole));
     for (std::size_t i = 0; i < obs_->log_value.size(); ++i) {
       detail::DipoleGradient sum;
       const auto add = [&](double weight, double r) {
@@ -178,61 +177,6 @@ struct ScalePrior {
   }
 };
 
-// Far-field log-slope and total reflectance of one channel's radial bins: start values (DESIGN §6).
-struct StartValues {
-  double sigma_a = 0.01, sigma_s_reduced = 1.0, log_scale = 0.0;
-};
-
-double far_field_sigma_tr(const RadialBins& bins, int c) {
-  std::vector<std::size_t> ok;
-  for (std::size_t i = 0; i < bins.size(); ++i) {
-    if (bins.value[c][i] > 3 * bins.standard_error[c][i] && bins.r_mm[i] > 0) ok.push_back(i);
-  }
-  if (ok.size() < 4) return 0.1;
-  // The outer half of the usable bins: log(R r^3 / (1 + s r)) ~ const - s r.
-  const std::vector<std::size_t> outer(ok.begin() + ok.size() / 2, ok.end());
-  double s = 0.0;
-  for (int iteration = 0; iteration < 4; ++iteration) {
-    double sw = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
-    for (std::size_t i : outer) {
-      const double r = bins.r_mm[i];
-      const double y = std::log(bins.value[c][i] * r * r * r / (1 + s * r));
-      const double w = std::pow(bins.value[c][i] / bins.standard_error[c][i], 2);
-      sw += w;
-      sx += w * r;
-      sy += w * y;
-      sxx += w * r * r;
-      sxy += w * r * y;
-    }
-    const double denominator = sw * sxx - sx * sx;
-    if (!(denominator > 0)) break;
-    s = std::max(1e-4, -(sw * sxy - sx * sy) / denominator);
-  }
-  return s;
-}
-
-double plane_total(const RadialBins& bins, int c, double sigma_tr) {
-  double total = 0;
-  for (std::size_t i = 0; i < bins.size(); ++i) {
-    double r0 = bins.r_inner_mm[i], r1 = bins.r_outer_mm[i];
-    if (!(r1 > r0)) {  // point samples: the annulus between the midpoints to the neighbours
-      r0 = i == 0 ? 0.0 : 0.5 * (bins.r_mm[i - 1] + bins.r_mm[i]);
-      r1 = i + 1 == bins.size() ? bins.r_mm[i] : 0.5 * (bins.r_mm[i] + bins.r_mm[i + 1]);
-    }
-    total += bins.value[c][i] * std::numbers::pi * (r1 * r1 - r0 * r0);
-  }
-  // Missing centre (first bin not at 0) and tail beyond the last bin: the far-field form
-  // C e^(-s r)(1 + s r)/r^3 matched to the last bin, integrated analytically: 2 pi C e^(-s R) / R.
-  if (bins.size() > 0) {
-    const std::size_t last = bins.size() - 1;
-    const double R = bins.r_outer_mm[last], r = bins.r_mm[last];
-    const double C =
-        bins.value[c][last] * r * r * r / ((1 + sigma_tr * r) * std::exp(-sigma_tr * r));
-    if (std::isfinite(C) && C > 0) total += 2 * std::numbers::pi * C * std::exp(-sigma_tr * R) / R;
-  }
-  return total;
-}
-
 }  // namespace
 
 GaussLegendre detail::gauss_legendre(int order) {
@@ -283,7 +227,7 @@ namespace {
 const char* kChannelNames[3] = {"R", "G", "B"};
 
 std::string model_name(FitModel m) {
-  return m == FitModel::kDipole ? "dipole" : m == FitModel::kDirectionalDipole ? "ddipole" : "auto";
+  return to_string(m);
 }
 
 // Usable observations of one channel of one capture, after exclusion and the noise floor.
@@ -318,6 +262,7 @@ Observations observations_for(const ProfileData& d, int c, double exclude_mm, bo
       o.y.push_back(s.y_mm[i]);
       o.log_value.push_back(std::log(s.value[c][i]));
       o.inv_rel_se.push_back(s.value[c][i] / s.standard_error[c][i]);
+      o.data_rel_se.push_back(s.standard_error[c][i] / s.value[c][i]);
     }
   } else {
     const RadialBins& b = d.radial;
@@ -326,8 +271,21 @@ Observations observations_for(const ProfileData& d, int c, double exclude_mm, bo
       o.radial = false;
       o.pixel = b.pixel_mm;
     }
+    // The usable range ends where the profile sinks into the noise: at the first two consecutive
+    // bins below the noise floor. Bins beyond are not fitted even when noise lifts one above it
+    // (keeping those would select upward fluctuations and bias the tail).
+    bool ended = false;
     for (std::size_t i = 0; i < b.size(); ++i) {
-      if (b.r_mm[i] < exclude_mm || !keep(b.value[c][i], b.standard_error[c][i])) continue;
+      if (b.r_mm[i] < exclude_mm) continue;
+      const auto below = [&](std::size_t k) {
+        return !(b.value[c][k] >= 2 * b.standard_error[c][k]) || !(b.standard_error[c][k] > 0);
+      };
+      if (!ended && below(i) && (i + 1 == b.size() || below(i + 1))) ended = true;
+      if (ended) {
+        ++*below_noise;
+        continue;
+      }
+      if (!keep(b.value[c][i], b.standard_error[c][i])) continue;
       o.r.push_back(b.r_mm[i]);
       o.r0.push_back(b.r_inner_mm[i]);
       o.r1.push_back(b.r_outer_mm[i]);
@@ -335,114 +293,10 @@ Observations observations_for(const ProfileData& d, int c, double exclude_mm, bo
       o.y.push_back(0.0);
       o.log_value.push_back(std::log(b.value[c][i]));
       o.inv_rel_se.push_back(b.value[c][i] / b.standard_error[c][i]);
+      o.data_rel_se.push_back(b.standard_error[c][i] / b.value[c][i]);
     }
   }
   return o;
-}
-
-StartValues start_values(const ProfileData& d, int c, double eta, bool relative, bool search) {
-  StartValues sv;
-  const double sigma_tr = far_field_sigma_tr(d.radial, c);
-  double alpha = 0.99;
-  const double A = materials::derive_coefficients(materials::Medium<double>{0, 1, 0, eta}).A_dipole;
-  const CaptureGeometry g = geometry_of(d);
-  const double fresnel = detail::fresnel_factor(g, eta, false);
-  if (!relative) {
-    const double total = plane_total(d.radial, c, sigma_tr) / fresnel;
-    if (total > 0 && total < 1)
-      alpha = materials::reduced_albedo_from_total_reflectance(total, eta);
-    alpha = std::clamp(alpha, 0.05, 1 - 1e-6);
-  } else {
-    // Unknown scale: the albedo whose dipole shape (for this sigma_tr) best matches the data, the
-    // scale from the mean log-ratio.
-    double best = INFINITY;
-    for (double one_minus = 0.5; one_minus > 1e-6; one_minus *= 0.7) {
-      const double a = 1 - one_minus;
-      const double st = sigma_tr / std::sqrt(3 * (1 - a));
-      const materials::StandardDipole<double> dipole(
-          materials::Medium<double>::from_reduced((1 - a) * st, a * st, eta));
-      double sum = 0, sum2 = 0;
-      int n = 0;
-      for (std::size_t i = 0; i < d.radial.size(); ++i) {
-        const double v = d.radial.value[c][i];
-        if (!(v > 2 * d.radial.standard_error[c][i]) || d.radial.r_mm[i] <= 0) continue;
-        const double diff = std::log(v) - std::log(fresnel * dipole.R_d(d.radial.r_mm[i]));
-        sum += diff;
-        sum2 += diff * diff;
-        ++n;
-      }
-      if (n < 2) break;
-      const double spread = sum2 / n - (sum / n) * (sum / n);
-      if (spread < best) {
-        best = spread;
-        alpha = a;
-        sv.log_scale = sum / n;
-      }
-    }
-  }
-  (void)A;
-  const double sigma_t_reduced = sigma_tr / std::sqrt(3 * (1 - alpha));
-  sv.sigma_a = (1 - alpha) * sigma_t_reduced;
-  sv.sigma_s_reduced = alpha * sigma_t_reduced;
-
-  // The far-field slope and total need an exponential tail and most of the light inside the image;
-  // a profile that ends within a diffusion length has neither. So also search a coarse grid of
-  // (alpha', sigma_t') on a dozen bins and keep whichever start matches the data better: a few
-  // thousand dipole evaluations, cheap next to the solve, and the solve starts in the right valley.
-  std::vector<std::size_t> use;
-  for (std::size_t i = 0; search && i < d.radial.size(); ++i) {
-    if (d.radial.r_mm[i] > 0 && d.radial.value[c][i] > 2 * d.radial.standard_error[c][i])
-      use.push_back(i);
-  }
-  if (use.size() >= 4) {
-    std::vector<std::size_t> pick;
-    for (int k = 0; k < 12; ++k)
-      pick.push_back(use[std::min(use.size() - 1, k * (use.size() - 1) / 11)]);
-    const double r_min = d.radial.r_mm[pick.front()], r_max = d.radial.r_mm[pick.back()];
-    std::array<double, 12> log_data{}, w{};
-    for (std::size_t k = 0; k < pick.size(); ++k) {
-      const std::size_t i = pick[k];
-      log_data[k] = std::log(d.radial.value[c][i]);
-      const double inv_rel = d.radial.value[c][i] / d.radial.standard_error[c][i];
-      w[k] = inv_rel * inv_rel;
-    }
-    const double log_fresnel = std::log(fresnel);
-    const auto cost = [&](double sa, double ss, double* log_scale) {
-      const materials::StandardDipole<double> dipole(materials::Medium<double>::from_reduced(sa, ss, eta));
-      double sum = 0, sum2 = 0, wsum = 0;
-      std::array<double, 12> diff{};
-      for (std::size_t k = 0; k < pick.size(); ++k) {
-        const double m = dipole.R_d(d.radial.r_mm[pick[k]]);
-        if (!(m > 0)) return double(INFINITY);
-        diff[k] = log_data[k] - log_fresnel - std::log(m);
-        sum += w[k] * diff[k];
-        wsum += w[k];
-      }
-      const double shift = relative ? sum / wsum : 0.0;
-      for (std::size_t k = 0; k < pick.size(); ++k) sum2 += w[k] * (diff[k] - shift) * (diff[k] - shift);
-      if (log_scale) *log_scale = shift;
-      return sum2;
-    };
-    double best_shift = sv.log_scale;
-    double best = cost(sv.sigma_a, sv.sigma_s_reduced, &best_shift);
-    const double alphas[] = {0.05, 0.2,  0.4,   0.6,   0.8,   0.9,    0.95,
-                             0.98, 0.99, 0.995, 0.998, 0.999, 0.9995, 0.9999};
-    for (double a : alphas) {
-      for (int k = 0; k < 16; ++k) {
-        const double st = 0.2 / r_max * std::pow(100.0 * r_max / r_min, k / 15.0);
-        double shift = 0;
-        const double value = cost((1 - a) * st, a * st, &shift);
-        if (value < best) {
-          best = value;
-          best_shift = shift;
-          sv.sigma_a = (1 - a) * st;
-          sv.sigma_s_reduced = a * st;
-        }
-      }
-    }
-    if (relative) sv.log_scale = best_shift;
-  }
-  return sv;
 }
 
 struct Problem {
@@ -468,9 +322,9 @@ std::string describe_combination(const Eigen::VectorXd& v, const std::vector<std
 }
 
 ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, FitModel model,
-               double eta0, bool relative, double exclude_mm,
-               const std::array<StartValues, 3>& start, std::array<bool, 3> channels,
-               int* below_noise) {
+               const materials::TabulatedProfile* table, double eta0, bool relative,
+               const std::array<double, 3>& exclude, const std::array<StartValues, 3>& start,
+               std::array<bool, 3> channels, int* below_noise) {
   const QualitySettings q = quality_settings(options.quality);
   const GaussLegendre gl = detail::gauss_legendre(q.footprint_order);
   Problem p;
@@ -481,6 +335,7 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
   }
   ceres::Problem problem;
   std::array<int, 3> samples{};
+  std::array<double, 3> range_end{};
   std::vector<std::pair<int, int>> block_channels;  // (channel, residuals) in insertion order
   std::vector<std::pair<double*, std::string>> calibration_blocks;
   for (std::size_t di = 0; di < data.size(); ++di) {
@@ -489,9 +344,23 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
     p.calibration.push_back({0.0, 0.0, 0.0});
     for (int c = 0; c < 3; ++c) {
       if (!channels[c] || !d.channels[c]) continue;
-      p.observations.push_back(observations_for(d, c, exclude_mm, use_2d, q, below_noise));
-      const Observations& o = p.observations.back();
+      p.observations.push_back(observations_for(d, c, exclude[c], use_2d, q, below_noise));
+      Observations& o = p.observations.back();
       if (o.log_value.empty()) continue;
+      for (std::size_t i = 0; i < o.log_value.size(); ++i)
+        range_end[c] = std::max(range_end[c], o.radial ? o.r[i] : std::hypot(o.x[i], o.y[i]));
+      if (model == FitModel::kTabulated) {
+        // The table's own Monte Carlo error joins the data's in each weight (at the start
+        // values: the weights stay fixed during the solve).
+        const double st = start[c].sigma_a + start[c].sigma_s_reduced;
+        const double alpha = start[c].sigma_s_reduced / st;
+        for (std::size_t i = 0; i < o.log_value.size(); ++i) {
+          const double r = o.radial ? o.r[i] : std::hypot(o.x[i], o.y[i]);
+          const double t = table->relative_se(detail::table_quantity(o.geometry), r * st, alpha, eta0);
+          const double d2 = o.data_rel_se[i] * o.data_rel_se[i];
+          o.inv_rel_se[i] = std::isfinite(t) ? 1.0 / std::sqrt(d2 + t * t) : 1e-3 / std::sqrt(d2);
+        }
+      }
       samples[c] += int(o.log_value.size());
       // The scale this capture's channel is known to: exact (held), fitted freely (relative), or
       // within the calibration's uncertainty (a prior).
@@ -515,12 +384,12 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
         block_channels.emplace_back(c, int(o.log_value.size()));
       } else if (options.loss == LossKind::kNone && !options.fit_ior && !scale_free) {
         auto* cost = new ceres::AutoDiffCostFunction<ChannelResiduals, ceres::DYNAMIC, 2>(
-            new ChannelResiduals{{&o, model, gl}, scale, &p.eta}, int(o.log_value.size()));
+            new ChannelResiduals{{&o, model, gl, table}, scale, &p.eta}, int(o.log_value.size()));
         problem.AddResidualBlock(cost, nullptr, p.ab[c].data());
         block_channels.emplace_back(c, int(o.log_value.size()));
       } else if (options.loss == LossKind::kNone) {
         auto* cost = new ceres::AutoDiffCostFunction<ProfileResiduals, ceres::DYNAMIC, 2, 1, 1>(
-            new ProfileResiduals{&o, model, gl}, int(o.log_value.size()));
+            new ProfileResiduals{&o, model, gl, table}, int(o.log_value.size()));
         problem.AddResidualBlock(cost, nullptr, p.ab[c].data(), scale, &p.eta);
         block_channels.emplace_back(c, int(o.log_value.size()));
       } else {
@@ -538,8 +407,9 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
           pick(one.y);
           pick(one.log_value);
           pick(one.inv_rel_se);
+          pick(one.data_rel_se);
           auto* cost = new ceres::AutoDiffCostFunction<ProfileResiduals, ceres::DYNAMIC, 2, 1, 1>(
-              new ProfileResiduals{&one, model, gl}, 1);
+              new ProfileResiduals{&one, model, gl, table}, 1);
           ceres::LossFunction* loss =
               options.loss == LossKind::kHuber
                   ? static_cast<ceres::LossFunction*>(new ceres::HuberLoss(options.loss_scale))
@@ -554,7 +424,7 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
     if (channels[c] && samples[c] < 2) {
       throw Error(std::string("fit: channel ") + kChannelNames[c] + " has " +
                   std::to_string(samples[c]) + " usable samples outside the exclusion radius (" +
-                  std::to_string(exclude_mm) +
+                  std::to_string(exclude[c]) +
                   " mm) and above the noise floor; at least 2 are needed for sigma_a and sigma_s'");
     }
   }
@@ -563,6 +433,9 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
   if (problem.HasParameterBlock(&p.eta)) {
     if (!options.fit_ior)
       problem.SetParameterBlockConstant(&p.eta);
+    else if (model == FitModel::kTabulated)
+      problem.SetParameterLowerBound(&p.eta, 0, table->eta_min()),
+          problem.SetParameterUpperBound(&p.eta, 0, table->eta_max());
     else
       problem.SetParameterLowerBound(&p.eta, 0, 1.0001),
           problem.SetParameterUpperBound(&p.eta, 0, 2.5);
@@ -664,8 +537,27 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
     // fit.chi2 (AIC, BIC) keeps the calibration priors' share: a model that reaches the data only
     // by rescaling the calibration far beyond its uncertainty pays for it.
     for (int c = 0; c < 3; ++c) {
-      fit.channels[c].chi2 = chi2[c];
-      fit.channels[c].residual_rms = samples[c] ? std::sqrt(chi2[c] / samples[c]) : 0.0;
+      ChannelFit& ch = fit.channels[c];
+      ch.chi2 = chi2[c];
+      ch.residual_rms = samples[c] ? std::sqrt(chi2[c] / samples[c]) : 0.0;
+      // Lack of fit: a reduced chi^2 above 1 says the residuals are larger than the standard
+      // errors allow, so the statistical spread is that much larger (Birge ratio).
+      ch.reduced_chi2 = samples[c] > 2 ? chi2[c] / (samples[c] - 2) : 0.0;
+      const double birge = std::sqrt(std::max(1.0, ch.reduced_chi2));
+      ch.sd_sigma_a *= birge;
+      ch.sd_sigma_s_reduced *= birge;
+      ch.sd_stat_sigma_a = ch.sd_sigma_a;
+      ch.sd_stat_sigma_s_reduced = ch.sd_sigma_s_reduced;
+      ch.exclude_radius_mm = exclude[c];
+    }
+  }
+  // The usable range of each channel: from its exclusion radius to its last fitted sample.
+  {
+    for (int c = 0; c < 3; ++c) fit.channels[c].range_end_mm = range_end[c];
+    for (ChannelFit& ch : fit.channels) {
+      const double sigma_tr = std::sqrt(3 * ch.sigma_a * (ch.sigma_a + ch.sigma_s_reduced));
+      ch.range_diffusion_lengths =
+          std::max(0.0, ch.range_end_mm - ch.exclude_radius_mm) * sigma_tr;
     }
   }
   fit.samples = samples[0] + samples[1] + samples[2];
@@ -739,32 +631,66 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
       given[c].sigma_s_reduced = (*options.start)[c][1];
     }
   }
-  if (options.exclude_radius_mm) {
-    result.exclude_radius_mm = *options.exclude_radius_mm;
-  } else {
-    // One transport mean free path, the largest over the channels.
-    double mfp = 0;
-    for (int c = 0; c < 3; ++c) {
-      if (channels[c]) mfp = std::max(mfp, 1.0 / (start[c].sigma_a + start[c].sigma_s_reduced));
-    }
-    result.exclude_radius_mm = mfp;
+  // The tabulated model applies to radial profiles at normal incidence and normal view.
+  bool radial_normal = true;
+  for (const ProfileData& d : data) {
+    if (d.incidence_polar_deg > 0.5 || (!d.exitance && d.view_deg > 0.5)) radial_normal = false;
   }
+  std::shared_ptr<materials::TabulatedProfile> full, fixed;
+  std::string table_problem;
+  if (radial_normal) {
+    try {
+      const materials::TransportTable& file =
+          options.table ? *options.table : materials::default_transport_table();
+      full = std::make_shared<materials::TabulatedProfile>(file, options.g);
+      if (!options.fit_ior) {
+        if (eta0 < full->eta_min() - 1e-9 || eta0 > full->eta_max() + 1e-9) {
+          std::ostringstream m;
+          m << "the relative index " << eta0 << " is outside the transport table's range "
+            << full->eta_min() << ".." << full->eta_max()
+            << " (build a wider table with lucent tabulate)";
+          table_problem = m.str();
+        } else {
+          fixed = std::make_shared<materials::TabulatedProfile>(full->at_eta(eta0));
+        }
+      }
+    } catch (const Error& e) {
+      table_problem = e.what();
+    }
+  } else {
+    table_problem =
+        "the tabulated model is for radial profiles at normal incidence and normal view";
+  }
+  const bool tab_ok = full && table_problem.empty();
+  if (options.model == FitModel::kTabulated && !tab_ok)
+    throw Error("--model tabulated: " + table_problem);
+  const materials::TabulatedProfile* tab = options.fit_ior ? full.get() : fixed.get();
+  result.g = options.g;
+  if (tab_ok) result.table = options.fit_ior ? full : fixed;
 
-  std::vector<FitModel> models;
-  if (options.model == FitModel::kAuto)
-    models = {FitModel::kDipole, FitModel::kDirectionalDipole};
-  else
-    models = {options.model};
+  // Each channel's exclusion radius from its own data.
+  double pixel_mm = 0;
+  for (const ProfileData& d : data) pixel_mm = std::max(pixel_mm, d.radial.pixel_mm);
+  const auto exclusion = [&](FitModel m, const std::array<StartValues, 3>& st) {
+    std::array<double, 3> e{};
+    for (int c = 0; c < 3; ++c) {
+      const double mfp = 1.0 / (st[c].sigma_a + st[c].sigma_s_reduced);
+      e[c] = options.exclude_radius_mm ? *options.exclude_radius_mm
+             : m == FitModel::kTabulated ? std::max(2 * pixel_mm, 0.1 * mfp)
+                                         : mfp;
+    }
+    return e;
+  };
   int below_noise = 0;
-  for (FitModel m : models) {
+  const auto fit_model = [&](FitModel m, const std::array<StartValues, 3>& first) {
+    const materials::TabulatedProfile* t = m == FitModel::kTabulated ? tab : nullptr;
+    const std::array<double, 3> ex = exclusion(m, start);
     below_noise = 0;
-    ModelFit best = solve(data, options, m, eta0, relative, result.exclude_radius_mm, start,
-                          channels, &below_noise);
+    ModelFit best = solve(data, options, m, t, eta0, relative, ex, first, channels, &below_noise);
     if (options.start) {
       // Given start values too; keep whichever start reaches the lower cost (a second start is the
       // cheap guard against the shallow valleys of low-albedo profiles).
-      ModelFit other = solve(data, options, m, eta0, relative, result.exclude_radius_mm, given,
-                             channels, &below_noise);
+      ModelFit other = solve(data, options, m, t, eta0, relative, ex, given, channels, &below_noise);
       if (other.chi2 <= best.chi2) best = other;
     }
     bool poor = !best.converged;
@@ -777,24 +703,66 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
       for (int c = 0; c < 3; ++c) {
         if (channels[c]) searched[c] = start_values(data.front(), c, eta0, relative, true);
       }
-      ModelFit other = solve(data, options, m, eta0, relative, result.exclude_radius_mm, searched,
-                             channels, &below_noise);
+      ModelFit other =
+          solve(data, options, m, t, eta0, relative, ex, searched, channels, &below_noise);
       if (other.chi2 < best.chi2) best = other;
     }
-    result.candidates.push_back(best);
+    return best;
+  };
+  const auto started_from = [&](const ModelFit& f) {
+    std::array<StartValues, 3> st = start;
+    for (int c = 0; c < 3; ++c) {
+      if (!channels[c]) continue;
+      st[c].sigma_a = f.channels[c].sigma_a;
+      st[c].sigma_s_reduced = f.channels[c].sigma_s_reduced;
+      st[c].log_scale = std::log(f.scale);
+    }
+    return st;
+  };
+
+  if (tab_ok && options.model != FitModel::kDirectionalDipole) {
+    // The accurate model, started from the standard dipole's solution (cheap, and in the valley).
+    const ModelFit dipole = fit_model(FitModel::kDipole, start);
+    ModelFit accurate = fit_model(FitModel::kTabulated, started_from(dipole));
+    result.candidates.push_back(accurate);
+    if (options.model != FitModel::kTabulated) result.candidates.push_back(dipole);
+    if (options.model == FitModel::kAuto)
+      result.candidates.push_back(fit_model(FitModel::kDirectionalDipole, start));
+    if (options.model == FitModel::kDipole) std::swap(result.candidates[0], result.candidates[1]);
+  } else if (tab_ok) {  // ddipole requested: the tabulated fit gives its systematic
+    result.candidates.push_back(fit_model(FitModel::kDirectionalDipole, start));
+    result.candidates.push_back(fit_model(FitModel::kTabulated, started_from(result.candidates[0])));
+  } else if (options.model == FitModel::kAuto) {
+    result.candidates.push_back(fit_model(FitModel::kDipole, start));
+    result.candidates.push_back(fit_model(FitModel::kDirectionalDipole, start));
+  } else {
+    result.candidates.push_back(fit_model(options.model, start));
   }
   if (below_noise > 0) {
     result.notes.push_back(std::to_string(below_noise) +
-                           " samples below the noise floor (value < 2 standard errors) left out");
+                           " samples below the noise floor (value < 2 standard errors, or past "
+                           "the point where the profile sinks into the noise) left out");
   }
+  for (const ProfileData& d : data)
+    result.notes.insert(result.notes.end(), d.notes.begin(), d.notes.end());
 
-  if (result.candidates.size() == 1) {
+  if (tab_ok) {
+    result.chosen = result.candidates.front();
+    if (options.model == FitModel::kAuto) {
+      result.reason =
+          "tabulated: exact to radiative transfer for a radial profile at normal incidence "
+          "(lucent's Monte Carlo transport table at g = " + std::to_string(options.g).substr(0, 4) +
+          "); the cheaper models are judged against it";
+    } else {
+      result.reason = "model " + model_name(result.chosen.model) + " requested";
+    }
+  } else if (result.candidates.size() == 1) {
     result.chosen = result.candidates.front();
     result.reason = "model " + model_name(result.chosen.model) + " requested";
   } else {
-    // The simplest model the data does not reject: the standard dipole unless the directional one
-    // fits markedly better (AIC lower by more than 10, i.e. the dipole is e^5 = 150 times less
-    // likely).
+    // No accurate model for these data: the simplest diffusion model the data does not reject,
+    // the standard dipole unless the directional one fits markedly better (AIC lower by more than
+    // 10, i.e. the dipole is e^5 = 150 times less likely).
     const ModelFit& dipole = result.candidates[0];
     const ModelFit& ddipole = result.candidates[1];
     std::ostringstream why;
@@ -808,8 +776,39 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
       why << "dipole: the simpler model is not rejected (AIC " << dipole.aic << " vs ddipole "
           << ddipole.aic << ")";
     }
+    why << "; no accurate model: " << table_problem;
     result.reason = why.str();
+    result.notes.push_back("no model exact to transport for these data (" + table_problem +
+                           "): the diffusion model's own error is not in the uncertainty");
   }
+  detail::finish_uncertainty(result, data, options, channels);
+  if (tab_ok && result.chosen.model == FitModel::kTabulated) {
+    detail::judge_adequacy(result, data, channels);
+    // g: radial data cannot tell it from sigma_s; say how far the answer moves at the other end.
+    const double g_other = options.g < 0.45 ? 0.9 : 0.0;
+    try {
+      const materials::TransportTable& file =
+          options.table ? *options.table : materials::default_transport_table();
+      const materials::TabulatedProfile other_full(file, g_other);
+      const materials::TabulatedProfile other =
+          options.fit_ior ? other_full : other_full.at_eta(result.chosen.eta);
+      const std::array<StartValues, 3> st = started_from(result.chosen);
+      int ignored = 0;
+      const ModelFit shifted = solve(data, options, FitModel::kTabulated, &other,
+                                     result.chosen.eta, relative, exclusion(FitModel::kTabulated, st),
+                                     st, channels, &ignored);
+      for (int c = 0; c < 3; ++c)
+        result.g_09.push_back({shifted.channels[c].sigma_a, shifted.channels[c].sigma_s_reduced});
+      result.g_other = g_other;
+    } catch (const Error&) {
+      // A table without that g: nothing to say.
+    }
+  }
+  result.exclude_radius_mm = INFINITY;
+  for (int c = 0; c < 3; ++c)
+    if (channels[c])
+      result.exclude_radius_mm =
+          std::min(result.exclude_radius_mm, result.chosen.channels[c].exclude_radius_mm);
   for (int c = 0; c < 3; ++c) {
     const double s = result.chosen.calibration_scale[c];
     const double se = data.front().calibration_relative_se[c];

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "lucent/acquire/profile.h"
@@ -33,9 +34,18 @@ ProfileData load_csv(const std::filesystem::path& path) {
   if (!in) throw Error(source + ": cannot open the profile");
   std::string line;
   int line_number = 0;
+  std::map<std::string, std::string> meta;  // key=value tokens of the leading comment lines
   while (std::getline(in, line)) {
     ++line_number;
-    if (!trim(line).empty() && trim(line)[0] != '#') break;
+    const std::string t = trim(line);
+    if (t.empty()) continue;
+    if (t[0] != '#') break;
+    std::stringstream tokens(t.substr(1));
+    std::string token;
+    while (tokens >> token) {
+      const auto eq = token.find('=');
+      if (eq != std::string::npos && eq > 0) meta[token.substr(0, eq)] = token.substr(eq + 1);
+    }
   }
   const std::vector<std::string> header = split(trim(line));
   std::map<std::string, int> column;
@@ -48,6 +58,43 @@ ProfileData load_csv(const std::filesystem::path& path) {
   ProfileData d;
   d.source = source;
   d.exitance = true;  // CSV values are per mm^2 per unit power entering the sample
+  d.per_incident_power = false;
+  const auto meta_number = [&](const std::string& key) -> std::optional<double> {
+    const auto it = meta.find(key);
+    if (it == meta.end()) return std::nullopt;
+    // "1.5" or per channel "1.5,1.5,1.5" (lucent simulate): the channels must agree.
+    const std::vector<std::string> parts = split(it->second);
+    std::optional<double> value;
+    for (const std::string& part : parts) {
+      double v = 0;
+      const auto [end, ec] = std::from_chars(part.data(), part.data() + part.size(), v);
+      if (ec != std::errc() || end != part.data() + part.size() || !std::isfinite(v))
+        throw Error(source + ": comment field " + key + "=" + it->second + ": expected a number");
+      if (value && std::abs(*value - v) > 1e-12)
+        throw Error(source + ": comment field " + key + "=" + it->second +
+                    ": the channels differ; lucent fit takes one value for all channels");
+      value = v;
+    }
+    return value;
+  };
+  if (auto eta = meta_number("ior")) d.eta = *eta;
+  if (auto eta = meta_number("eta")) d.eta = *eta;
+  if (d.eta && !(*d.eta > 0 && *d.eta <= 4))
+    throw Error(source + ": comment field ior/eta: expected a relative index in (0, 4]");
+  if (auto it = meta.find("quantity"); it != meta.end()) {
+    if (it->second == "radiance")
+      d.exitance = false;
+    else if (it->second != "exitance")
+      throw Error(source + ": comment field quantity=" + it->second +
+                  ": expected exitance or radiance");
+  }
+  if (auto it = meta.find("R_unit"); it != meta.end())
+    d.per_incident_power = it->second.find("per_unit_incident_power") != std::string::npos;
+  if (auto incidence = meta_number("incidence_deg")) {
+    if (!(*incidence >= 0 && *incidence < 90))
+      throw Error(source + ": comment field incidence_deg: expected [0, 90) degrees");
+    d.incidence_polar_deg = *incidence;
+  }
   std::array<int, 3> value_col{-1, -1, -1}, se_col{-1, -1, -1};
   const char* suffix[3] = {"_r", "_g", "_b"};
   if (has("R")) {
@@ -69,6 +116,7 @@ ProfileData load_csv(const std::filesystem::path& path) {
   const int inner = has("r_inner_mm") ? column["r_inner_mm"] : -1;
   const int outer = has("r_outer_mm") ? column["r_outer_mm"] : -1;
   bool assumed_errors = false;
+  int zero_se_rows = 0;
   while (std::getline(in, line)) {
     ++line_number;
     if (trim(line).empty() || trim(line)[0] == '#') continue;
@@ -90,25 +138,38 @@ ProfileData load_csv(const std::filesystem::path& path) {
     };
     const double r = number(column["r_mm"]);
     if (r < 0) throw Error(where + "r_mm must be >= 0");
+    std::array<double, 3> v{}, se{};
+    bool zero = false;
+    for (int c = 0; c < 3; ++c) {
+      v[c] = value_col[c] >= 0 ? number(value_col[c]) : 0.0;
+      if (se_col[c] >= 0) {
+        se[c] = number(se_col[c]);
+        if (se[c] < 0)
+          throw Error(where + "column " + header[se_col[c]] + ": expected a standard error >= 0");
+        // 0: a Monte Carlo bin no photon reached (value 0 too); skipped, not fitted.
+        if (se[c] == 0 && d.channels[c]) zero = true;
+      } else {
+        se[c] = 0.05 * std::abs(v[c]);  // documented assumption: 5% relative error
+        assumed_errors = true;
+      }
+    }
+    if (zero) {
+      ++zero_se_rows;
+      continue;
+    }
     d.radial.r_mm.push_back(r);
     d.radial.r_inner_mm.push_back(inner >= 0 ? number(inner) : r);
     d.radial.r_outer_mm.push_back(outer >= 0 ? number(outer) : r);
     for (int c = 0; c < 3; ++c) {
-      const double v = value_col[c] >= 0 ? number(value_col[c]) : 0.0;
-      double se = 0;
-      if (se_col[c] >= 0) {
-        se = number(se_col[c]);
-        if (!(se > 0))
-          throw Error(where + "column " + header[se_col[c]] + ": expected a standard error > 0");
-      } else {
-        se = 0.05 * std::abs(v);  // documented assumption: 5% relative error
-        assumed_errors = true;
-      }
-      d.radial.value[c].push_back(v);
-      d.radial.standard_error[c].push_back(se);
+      d.radial.value[c].push_back(v[c]);
+      d.radial.standard_error[c].push_back(se[c]);
     }
   }
-  (void)assumed_errors;
+  if (assumed_errors)
+    d.notes.push_back(source + ": no standard-error columns; 5% relative errors assumed");
+  if (zero_se_rows > 0)
+    d.notes.push_back(source + ": " + std::to_string(zero_se_rows) +
+                      " rows with a zero standard error (no data) skipped");
   if (d.radial.size() == 0) throw Error(source + ": the profile is empty (a header and no rows)");
   return d;
 }

@@ -10,7 +10,7 @@ namespace {
 using nlohmann::json;
 
 std::string name_of(FitModel m) {
-  return m == FitModel::kDipole ? "dipole" : m == FitModel::kDirectionalDipole ? "ddipole" : "auto";
+  return to_string(m);
 }
 
 std::string name_of(Quality q) {
@@ -28,6 +28,14 @@ json model_fit_json(const ModelFit& f) {
                         {"sigma_s_reduced", finite_or_null(c.sigma_s_reduced)},
                         {"sd_sigma_a", finite_or_null(c.sd_sigma_a)},
                         {"sd_sigma_s_reduced", finite_or_null(c.sd_sigma_s_reduced)},
+                        {"sd_stat_sigma_a", finite_or_null(c.sd_stat_sigma_a)},
+                        {"sd_stat_sigma_s_reduced", finite_or_null(c.sd_stat_sigma_s_reduced)},
+                        {"sd_sys_sigma_a", finite_or_null(c.sd_sys_sigma_a)},
+                        {"sd_sys_sigma_s_reduced", finite_or_null(c.sd_sys_sigma_s_reduced)},
+                        {"reduced_chi2", finite_or_null(c.reduced_chi2)},
+                        {"exclude_radius_mm", finite_or_null(c.exclude_radius_mm)},
+                        {"range_end_mm", finite_or_null(c.range_end_mm)},
+                        {"range_diffusion_lengths", finite_or_null(c.range_diffusion_lengths)},
                         {"correlation", finite_or_null(c.correlation)},
                         {"start_sigma_a", finite_or_null(c.start_sigma_a)},
                         {"start_sigma_s_reduced", finite_or_null(c.start_sigma_s_reduced)},
@@ -54,6 +62,33 @@ json model_fit_json(const ModelFit& f) {
           {"message", f.message}};
 }
 
+json adequacy_json(const FitResult& r) {
+  json a = json::array();
+  for (const ModelAdequacy& m : r.adequacy)
+    a.push_back({{"model", name_of(m.model)},
+                 {"tolerance", m.tolerance},
+                 {"within_tolerance_beyond_mm", finite_or_null(m.beyond_mm)},
+                 {"max_deviation", finite_or_null(m.max_deviation)},
+                 {"adequate", m.adequate}});
+  return a;
+}
+
+json g_systematic_json(const FitResult& r) {
+  if (r.g_09.empty()) return nullptr;
+  json shift_a = json::array(), shift_s = json::array();
+  for (int c = 0; c < 3; ++c) {
+    shift_a.push_back(finite_or_null(r.g_09[c][0] - r.chosen.channels[c].sigma_a));
+    shift_s.push_back(finite_or_null(r.g_09[c][1] - r.chosen.channels[c].sigma_s_reduced));
+  }
+  return {{"assumed_g", r.g},
+          {"other_g", r.g_other},
+          {"shift_sigma_a", shift_a},
+          {"shift_sigma_s_reduced", shift_s},
+          {"note", "radial normal-incidence data cannot separate g from sigma_s: the fit at "
+                   "other_g moves by these amounts (mm^-1); not in the total, which holds for "
+                   "the assumed g"}};
+}
+
 json inputs_json(const std::vector<ProfileData>& data) {
   json inputs = json::array();
   for (const ProfileData& d : data) inputs.push_back(d.source);
@@ -69,18 +104,32 @@ materials::Material fitted_material(const FitResult& result, const std::vector<P
   m.name = name;
   m.ior = f.eta;
   m.model = name_of(f.model);
+  m.adequate_model = result.adequate_model;
   json sd_a = json::array(), sd_s = json::array(), corr = json::array();
+  json stat_a = json::array(), stat_s = json::array(), sys_a = json::array(), sys_s = json::array();
   for (int c = 0; c < 3; ++c) {
-    m.sigma_a[c] = f.channels[c].sigma_a;
-    m.sigma_s_reduced[c] = f.channels[c].sigma_s_reduced;
-    sd_a.push_back(f.channels[c].sd_sigma_a);
-    sd_s.push_back(f.channels[c].sd_sigma_s_reduced);
-    corr.push_back(f.channels[c].correlation);
+    const ChannelFit& ch = f.channels[c];
+    m.sigma_a[c] = ch.sigma_a;
+    m.sigma_s_reduced[c] = ch.sigma_s_reduced;
+    sd_a.push_back(ch.sd_sigma_a);
+    sd_s.push_back(ch.sd_sigma_s_reduced);
+    stat_a.push_back(ch.sd_stat_sigma_a);
+    stat_s.push_back(ch.sd_stat_sigma_s_reduced);
+    sys_a.push_back(ch.sd_sys_sigma_a);
+    sys_s.push_back(ch.sd_sys_sigma_s_reduced);
+    corr.push_back(ch.correlation);
   }
-  m.uncertainty = {{"sigma_a", sd_a},
-                   {"sigma_s_reduced", sd_s},
-                   {"correlation_sigma_a_sigma_s_reduced", corr},
-                   {"kind", "one standard deviation, from the Jacobian at the solution"}};
+  m.uncertainty = {
+      {"sigma_a", sd_a},
+      {"sigma_s_reduced", sd_s},
+      {"statistical", {{"sigma_a", stat_a}, {"sigma_s_reduced", stat_s}}},
+      {"systematic", {{"sigma_a", sys_a}, {"sigma_s_reduced", sys_s}}},
+      {"correlation_sigma_a_sigma_s_reduced", corr},
+      {"kind",
+       "one standard deviation, mm^-1: total = statistical (Jacobian at the solution, "
+       "calibration prior included, scaled by sqrt(reduced chi^2) when above 1) and systematic "
+       "(the model's own error: a diffusion model's difference from the tabulated model on the "
+       "same data) in quadrature"}};
   if (options.fit_ior) m.uncertainty["ior"] = f.sd_eta;
   if (!f.undetermined.empty()) m.uncertainty["undetermined"] = f.undetermined;
   int residuals = 0;
@@ -99,6 +148,11 @@ materials::Material fitted_material(const FitResult& result, const std::vector<P
                     {"time_ms", f.time_ms},
                     {"quality", name_of(options.quality)},
                     {"scale", f.scale},
+                    {"g", result.g},
+                    {"g_systematic", g_systematic_json(result)},
+                    {"adequate_model", result.adequate_model},
+                    {"adequacy", adequacy_json(result)},
+                    {"warnings", result.warnings},
                     {"notes", result.notes}}}};
   return m;
 }
@@ -117,6 +171,11 @@ json fit_report(const FitResult& result, const std::vector<ProfileData>& data,
           {"quality", name_of(options.quality)},
           {"relative", options.relative.value_or(false)},
           {"notes", result.notes},
+          {"warnings", result.warnings},
+          {"g", result.g},
+          {"g_systematic", g_systematic_json(result)},
+          {"adequate_model", result.adequate_model},
+          {"adequacy", adequacy_json(result)},
           {"tool", std::string("lucent fit ") + kVersion}};
 }
 

@@ -9,22 +9,21 @@
 
 namespace lucent::fit {
 
-double predicted_radial(const ModelFit& fit, const ProfileData& data, int c, double r) {
+double predicted_radial(const ModelFit& fit, const ProfileData& data, int c, double r,
+                        const materials::TabulatedProfile* table) {
   const materials::Medium<double> medium = materials::Medium<double>::from_reduced(
       fit.channels[c].sigma_a, fit.channels[c].sigma_s_reduced, fit.eta);
   detail::CaptureGeometry g;
   g.cos_incidence = std::cos(data.incidence_polar_deg * std::numbers::pi / 180);
   g.cos_view = std::cos(data.view_deg * std::numbers::pi / 180);
   g.exitance = data.exitance;
+  g.per_incident_power = data.per_incident_power;
   // What the fit compares with: a pixel footprint at r when the bins are pixel averages.
   const detail::GaussLegendre gl = detail::gauss_legendre(2);
   const double p = data.radial.pixel_mm;
   const double v =
-      fit.model == FitModel::kDipole
-          ? detail::dipole_pixel(materials::StandardDipole<double>(medium), r, 0.0, p, gl)
-          : detail::ddipole_pixel(materials::DirectionalDipole<double>(medium), g, r, 0.0, p, gl);
-  return fit.scale * fit.calibration_scale[c] *
-         detail::fresnel_factor(g, fit.eta, fit.model == FitModel::kDirectionalDipole) * v;
+      detail::model_value(fit.model, table, medium, g, false, r, r, r, r, 0.0, p, gl);
+  return fit.scale * fit.calibration_scale[c] * detail::fresnel_factor(g, fit.eta, fit.model) * v;
 }
 
 void write_fit_plot(const std::filesystem::path& path, const FitResult& result,
@@ -40,7 +39,7 @@ void write_fit_plot(const std::filesystem::path& path, const FitResult& result,
   PlotPanel profile;
   profile.title =
       "profile: data (points, +-1 SE) and " +
-      std::string(f.model == FitModel::kDipole ? "standard dipole" : "directional dipole") +
+      to_string(f.model) +
       " fit (lines); excluded region in light colours; y: " +
       (data.calibrated ? "pi L / P (1/mm^2)" : "pi L (relative)");
   profile.x_label = "r (mm)";
@@ -66,7 +65,7 @@ void write_fit_plot(const std::filesystem::path& path, const FitResult& result,
       s.y.push_back(b.value[c][i]);
       s.y_error.push_back(b.standard_error[c][i]);
       if (in && b.value[c][i] > 0) {
-        const double m = predicted_radial(f, data, c, b.r_mm[i]);
+        const double m = predicted_radial(f, data, c, b.r_mm[i], result.table.get());
         res.x.push_back(b.r_mm[i]);
         res.y.push_back(std::log(m / b.value[c][i]) * b.value[c][i] / b.standard_error[c][i]);
       }
@@ -79,7 +78,7 @@ void write_fit_plot(const std::filesystem::path& path, const FitResult& result,
     for (int k = 0; k <= 300; ++k) {
       const double r = r_max * k / 300.0;
       curve.x.push_back(r);
-      curve.y.push_back(predicted_radial(f, data, c, r));
+      curve.y.push_back(predicted_radial(f, data, c, r, result.table.get()));
     }
     profile.series.push_back(excluded);
     profile.series.push_back(used);

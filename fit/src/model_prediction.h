@@ -7,9 +7,11 @@
 #include <cmath>
 #include <numbers>
 
+#include "lucent/fit/fit.h"
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/directional_dipole.h"
 #include "lucent/materials/fresnel.h"
+#include "lucent/materials/tabulated.h"
 
 namespace lucent::fit::detail {
 
@@ -25,22 +27,35 @@ struct CaptureGeometry {
   double cos_incidence = 1;            ///< cos of the beam's polar angle
   double cos_view = 1;                 ///< cos of the camera's polar angle
   std::array<double, 3> w_i{0, 0, 1};  ///< unit, from the entry point toward the light
-  /// The data are exitance per unit power entering the sample (Monte Carlo tallies, CSV), not a
-  /// camera's radiance per unit incident power.
+  /// The data are exitance (all directions), not pi L along the view direction.
   bool exitance = false;
+  /// Per unit power incident on the sample (a camera), not per unit power entering it.
+  bool per_incident_power = true;
 };
 
-/// What multiplies the model's R_d (dipole) or pi S_d (ddipole) to give the measured quantity: both
-/// Fresnel transmittances for a camera (pi L / P); for exitance per unit power entering, nothing
-/// for the dipole (R_d is an exitance) and the outgoing hemispherical transmittance for the
-/// ddipole, pi S_d integrated against F_t cos over the hemisphere: eta^2 (1 - F_dr(eta))
-/// (transmittance from inside is 1 - F_dr, from outside eta^2 times that).
+/// What multiplies the model's value (dipole R_d, ddipole pi S_d, the table's exitance or normal
+/// radiance, all per unit power entering) to give the measured quantity. Per unit incident
+/// power: the entry transmittance F_t(incidence). Exitance: nothing for the dipole (R_d is an
+/// exitance) and the table; for the ddipole its outgoing hemispherical transmittance, pi S_d
+/// integrated against F_t cos over the hemisphere: eta^2 (1 - F_dr(eta)) (transmittance from
+/// inside is 1 - F_dr, from outside eta^2 times that). Radiance: the dipoles' outgoing
+/// transmittance F_t(view); nothing for the table, whose radiance has it already.
 template <typename T>
-T fresnel_factor(const CaptureGeometry& g, const T& eta, bool directional) {
+T fresnel_factor(const CaptureGeometry& g, const T& eta, FitModel model) {
   using materials::fresnel_transmittance;
-  if (g.exitance)
-    return directional ? eta * eta * (T(1) - materials::diffuse_fresnel_reflectance(eta)) : T(1);
-  return fresnel_transmittance(T(g.cos_incidence), eta) * fresnel_transmittance(T(g.cos_view), eta);
+  T front = g.per_incident_power ? fresnel_transmittance(T(g.cos_incidence), eta) : T(1);
+  if (model == FitModel::kTabulated) return front;
+  if (g.exitance) {
+    return model == FitModel::kDirectionalDipole
+               ? front * eta * eta * (T(1) - materials::diffuse_fresnel_reflectance(eta))
+               : front;
+  }
+  return front * fresnel_transmittance(T(g.cos_view), eta);
+}
+
+/// The table's quantity for the data's.
+inline materials::TableQuantity table_quantity(const CaptureGeometry& g) {
+  return g.exitance ? materials::TableQuantity::kExitance : materials::TableQuantity::kRadiance;
 }
 
 /// Standard dipole: mean of R_d over the annulus [r0, r1] (or R_d(r) when r0 == r1), per mm^2.
@@ -111,6 +126,54 @@ T dipole_pixel(const materials::StandardDipole<T>& dipole, double x, double y, d
     }
   }
   return sum;
+}
+
+/// The tabulated model over an annulus (mean over area, nodes uniform in r^2) or at a point.
+template <typename T>
+T tabulated_annulus(const materials::TabulatedModel<T>& m, materials::TableQuantity q, double r,
+                    double r0, double r1, const GaussLegendre& gl) {
+  if (!(r1 > r0)) return m.at(q, T(r));
+  T sum(0);
+  for (int k = 0; k < gl.order; ++k)
+    sum += gl.weight[k] * m.at(q, T(std::sqrt(r0 * r0 + gl.node[k] * (r1 * r1 - r0 * r0))));
+  return sum;
+}
+
+/// The tabulated model over a square pixel footprint centred at (x, y).
+template <typename T>
+T tabulated_pixel(const materials::TabulatedModel<T>& m, materials::TableQuantity q, double x,
+                  double y, double pixel, const GaussLegendre& gl) {
+  if (!(pixel > 0)) return m.at(q, T(std::hypot(x, y)));
+  T sum(0);
+  for (int a = 0; a < gl.order; ++a)
+    for (int b = 0; b < gl.order; ++b)
+      sum += gl.weight[a] * gl.weight[b] *
+             m.at(q, T(std::hypot(x + (gl.node[a] - 0.5) * pixel, y + (gl.node[b] - 0.5) * pixel)));
+  return sum;
+}
+
+/// One sample's model value (before fresnel_factor): a radial bin (annulus, or a pixel footprint
+/// at the bin's radius when `pixel` > 0 and not `radial`) or a 2D pixel.
+template <typename T>
+T model_value(FitModel model, const materials::TabulatedProfile* table,
+              const materials::Medium<T>& medium, const CaptureGeometry& g, bool radial, double r,
+              double r0, double r1, double x, double y, double pixel, const GaussLegendre& gl) {
+  switch (model) {
+    case FitModel::kDipole: {
+      const materials::StandardDipole<T> dipole(medium);
+      return radial ? dipole_annulus(dipole, r, r0, r1, gl) : dipole_pixel(dipole, x, y, pixel, gl);
+    }
+    case FitModel::kTabulated: {
+      const materials::TabulatedModel<T> tab(*table, medium);
+      const materials::TableQuantity q = table_quantity(g);
+      return radial ? tabulated_annulus(tab, q, r, r0, r1, gl)
+                    : tabulated_pixel(tab, q, x, y, pixel, gl);
+    }
+    default: {
+      const materials::DirectionalDipole<T> dd(medium);
+      return radial ? ddipole_annulus(dd, r, r0, r1, gl) : ddipole_pixel(dd, g, x, y, pixel, gl);
+    }
+  }
 }
 
 }  // namespace lucent::fit::detail

@@ -30,9 +30,10 @@ constexpr std::string_view kFormatName = "lucent-material";
 constexpr std::array<std::string_view, 3> kChannelNames = {"R", "G", "B"};
 
 // Every top-level field the format knows, in the order they are written.
-constexpr std::array<std::string_view, 12> kKnownFields = {
-    "format",  "version", "name",  "ior",         "sigma_a",    "sigma_s_reduced",
-    "sigma_s", "g",       "model", "uncertainty", "provenance", "derived"};
+constexpr std::array<std::string_view, 13> kKnownFields = {
+    "format",  "version", "name",           "ior",         "sigma_a",    "sigma_s_reduced",
+    "sigma_s", "g",       "model",          "adequate_model", "uncertainty", "provenance",
+    "derived"};
 
 // Agreement required between a given sigma_s' and sigma_s (1 - g): relative, with an absolute floor
 // for channels that (almost) do not scatter, where a relative test would demand exact zeros.
@@ -152,6 +153,16 @@ class MaterialReader {
     if (const json* model = find("model")) {
       if (!model->is_string()) fail("model", "expected a string, found " + describe(*model));
       m.model = model->get<std::string>();
+      if (m.model != "dipole" && m.model != "ddipole" && m.model != "tabulated")
+        fail("model", "expected \"dipole\", \"ddipole\" or \"tabulated\", found \"" +
+                          truncated(m.model) + "\"");
+    }
+    if (const json* adequate = find("adequate_model")) {
+      if (!adequate->is_string() ||
+          (*adequate != "dipole" && *adequate != "ddipole" && *adequate != "tabulated"))
+        fail("adequate_model",
+             "expected \"dipole\", \"ddipole\" or \"tabulated\", found " + describe(*adequate));
+      m.adequate_model = adequate->get<std::string>();
     }
     m.uncertainty = read_object_or_null("uncertainty");
     m.provenance = read_object_or_null("provenance");
@@ -340,6 +351,13 @@ Material material_from_json(const nlohmann::json& doc, const std::string& source
   }
 }
 
+std::string Material::diffusion_model(const std::string& fallback) const {
+  if (model == "dipole" || model == "ddipole") return model;
+  if (model == "tabulated")
+    return adequate_model == "dipole" || adequate_model == "ddipole" ? adequate_model : "ddipole";
+  return fallback;
+}
+
 nlohmann::json material_to_json(const Material& material) {
   json doc;
   doc["format"] = kFormatName;
@@ -351,6 +369,7 @@ nlohmann::json material_to_json(const Material& material) {
   if (material.sigma_s) doc["sigma_s"] = rgb_json(*material.sigma_s);
   if (material.g) doc["g"] = rgb_json(*material.g);
   if (!material.model.empty()) doc["model"] = material.model;
+  if (!material.adequate_model.empty()) doc["adequate_model"] = material.adequate_model;
   if (!material.uncertainty.is_null()) doc["uncertainty"] = material.uncertainty;
   if (!material.provenance.is_null()) doc["provenance"] = material.provenance;
 

@@ -3,12 +3,16 @@
 #include <charconv>
 #include <cmath>
 #include <istream>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <numbers>
 #include <sstream>
 
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/error.h"
 #include "lucent/materials/quadrature.h"
+#include "lucent/materials/tabulated.h"
 
 namespace lucent::materials {
 namespace {
@@ -64,14 +68,32 @@ Vec3<double> plane_normal() {
 
 }  // namespace
 
-DiffusionModel parse_diffusion_model(const std::string& name, const std::string& option) {
+DiffusionModel parse_diffusion_model(const std::string& name, const std::string& option,
+                                     bool allow_tabulated) {
   if (name == "dipole") return DiffusionModel::kDipole;
   if (name == "ddipole") return DiffusionModel::kDirectionalDipole;
-  throw Error(option + ": expected 'dipole' or 'ddipole', got '" + name + "'");
+  if (name == "tabulated" && allow_tabulated) return DiffusionModel::kTabulated;
+  if (name == "tabulated")
+    throw Error(option + ": 'tabulated' is radial only (normal incidence on a plane); expected "
+                         "'dipole' or 'ddipole' here");
+  throw Error(option + ": expected 'dipole', 'ddipole'" +
+              std::string(allow_tabulated ? " or 'tabulated'" : "") + ", got '" + name + "'");
 }
 
 std::string to_string(DiffusionModel model) {
-  return model == DiffusionModel::kDipole ? "dipole" : "ddipole";
+  return model == DiffusionModel::kDipole              ? "dipole"
+         : model == DiffusionModel::kDirectionalDipole ? "ddipole"
+                                                       : "tabulated";
+}
+
+const TabulatedProfile& tabulated_profile_for(double g) {
+  // One prepared profile per g (materials with sigma_s and g carry their own per channel).
+  static std::mutex mutex;
+  static std::map<double, std::unique_ptr<TabulatedProfile>> cache;
+  std::lock_guard lock(mutex);
+  auto& slot = cache[g];
+  if (!slot) slot = std::make_unique<TabulatedProfile>(default_transport_table(), g);
+  return *slot;
 }
 
 std::vector<double> parse_radius_list(const std::string& text, const std::string& option) {
@@ -122,6 +144,9 @@ std::vector<double> parse_radius_range(const std::string& text, const std::strin
 
 std::array<double, 3> evaluate_bssrdf(const Material& material, DiffusionModel model,
                                       const BssrdfConfig& c) {
+  if (model == DiffusionModel::kTabulated)
+    throw Error("--configs: the tabulated model is radial only (normal incidence on a plane); "
+                "use --r or --r-range");
   std::array<double, 3> S{};
   for (int channel = 0; channel < 3; ++channel) {
     const Medium<double> medium = material.medium(channel);
@@ -134,42 +159,77 @@ std::array<double, 3> evaluate_bssrdf(const Material& material, DiffusionModel m
   return S;
 }
 
+double radial_profile_value(const Material& material, int channel, DiffusionModel model,
+                            TableQuantity quantity, double r) {
+  const Medium<double> medium = material.medium(channel);
+  const bool radiance = quantity == TableQuantity::kRadiance;
+  switch (model) {
+    case DiffusionModel::kDipole: {
+      const double v = StandardDipole<double>(medium).R_d(r);
+      return radiance ? v * fresnel_transmittance(1.0, medium.eta) : v;
+    }
+    case DiffusionModel::kDirectionalDipole: {
+      const DirectionalDipole<double> ddipole(medium);
+      const double pi_s = std::numbers::pi * ddipole.S_d(Vec3<double>::Zero(), plane_normal(),
+                                                         plane_normal(), Vec3<double>(r, 0.0, 0.0),
+                                                         plane_normal());
+      return pi_s * (radiance ? fresnel_transmittance(1.0, medium.eta)
+                              : medium.eta * medium.eta *
+                                    (1 - diffuse_fresnel_reflectance(medium.eta)));
+    }
+    case DiffusionModel::kTabulated: {
+      const TabulatedProfile& p = tabulated_profile_for(medium.g);
+      if (medium.eta < p.eta_min() - 1e-12 || medium.eta > p.eta_max() + 1e-12)
+        throw Error("ior: " + format_input(medium.eta) + " is outside the transport table's eta range " +
+                    format_input(p.eta_min()) + ".." + format_input(p.eta_max()));
+      return TabulatedModel<double>(p, medium).at(quantity, r);
+    }
+  }
+  return 0.0;
+}
+
 std::string radial_profile_csv(const Material& material, const RadialProfileOptions& options) {
   std::ostringstream out;
-  out << "r_mm,Rd_r,Rd_g,Rd_b\n";
-  const Vec3<double> origin = Vec3<double>::Zero();
-  const auto radial_value = [&](int channel, double r) {
-    const Medium<double> medium = material.medium(channel);
-    if (options.model == DiffusionModel::kDipole) return StandardDipole<double>(medium).R_d(r);
-    const DirectionalDipole<double> ddipole(medium);
-    return std::numbers::pi * ddipole.S_d(origin, plane_normal(), plane_normal(),
-                                          Vec3<double>(r, 0.0, 0.0), plane_normal());
-  };
+  out << "# format=lucent-radial-profile version=1 quantity=" << to_string(options.quantity)
+      << " ior=" << format_input(material.ior) << " model=" << to_string(options.model)
+      << " incidence_deg=0 units=mm^-2_per_unit_power_entering material=" << material.name
+      << "\n";
+  std::ostringstream rows;
+  rows << "r_mm,R_r,R_g,R_b\n";
   for (double r : options.r_mm) {
-    out << format_input(r);
+    rows << format_input(r);
     for (int channel = 0; channel < 3; ++channel)
-      out << ',' << format_number(radial_value(channel, r));
-    out << '\n';
+      rows << ',' << format_number(radial_profile_value(material, channel, options.model,
+                                                        options.quantity, r));
+    rows << '\n';
   }
   if (options.total) {
-    out << "total";
+    out << "# total=";
     for (int channel = 0; channel < 3; ++channel) {
       const Medium<double> medium = material.medium(channel);
       double total = 0.0;
       if (options.model == DiffusionModel::kDipole) {
         total = StandardDipole<double>(medium).total_diffuse_reflectance();
+      } else if (options.model == DiffusionModel::kTabulated) {
+        radial_profile_value(material, channel, options.model, options.quantity, 1.0);  // range
+        total = TabulatedModel<double>(tabulated_profile_for(medium.g), medium)
+                    .total_diffuse_reflectance();
       } else {
         const auto c = derive_coefficients(medium);
         if (c.scatters()) {
-          total =
-              integrate_over_plane([&](double r) { return radial_value(channel, r); }, c.z_r, 1e-9);
+          total = integrate_over_plane(
+              [&](double r) {
+                return radial_profile_value(material, channel, options.model,
+                                            TableQuantity::kExitance, r);
+              },
+              c.z_r, 1e-9);
         }
       }
-      out << ',' << format_number(total);
+      out << (channel ? "," : "") << format_number(total);
     }
     out << '\n';
   }
-  return out.str();
+  return out.str() + rows.str();
 }
 
 std::vector<BssrdfConfig> read_bssrdf_configs(std::istream& in, const std::string& source) {

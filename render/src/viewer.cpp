@@ -590,7 +590,7 @@ void Viewer::load_material(const std::string& source) {
   message_ = "material: " + scene_.material.name;
   if (model_from_material_ && !scene_.material.model.empty()) {
     settings_.model = pending_.model =
-        materials::parse_diffusion_model(scene_.material.model, "material model");
+        materials::parse_diffusion_model(scene_.material.diffusion_model(), "material model");
   }
   glfwSetWindowTitle(window_,
                      ("lucent view - " + scene_.material.name + " on " + scene_.mesh.name).c_str());

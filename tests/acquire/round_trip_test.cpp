@@ -76,5 +76,74 @@ TEST(RoundTrip, SimulateThenAcquireRecoversTheRadianceInAbsoluteUnits) {
   fs::remove_all(acq);
 }
 
+
+// The faint tail without bias (no floor from dark subtraction, censoring or noise-dependent
+// weights): every bin of a 0.25 mm capture against the truth averaged over the same pixels, the
+// truth's own Monte Carlo error and the calibration's in the standard error.
+class ProfileWithoutBias : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(ProfileWithoutBias, EveryBinAgreesWithTheTruthDownToTheNoise) {
+  const std::string name = GetParam();
+  const fs::path sim = fresh_dir("bias-sim-" + name), acq = fresh_dir("bias-acq-" + name);
+  SimulateOptions o;
+  o.material = materials::load_material(name);
+  o.transport.photons = 40000;
+  o.transport.size = 128;
+  o.transport.pixel_mm = 0.25;
+  o.transport.threads = 2;
+  o.camera.seed = 5;
+  run_simulation(o, sim);
+  const AcquireSummary summary = run_acquire(sim / "capture.json", acq, AcquireOptions{});
+  ASSERT_TRUE(summary.calibrated);
+  const Profile profile = read_profile(acq / "profile.json");
+  const ImageRgb truth = read_exr(sim / "truth_radiance.exr");
+  const ImageRgb truth_se = read_exr(sim / "truth_radiance_se.exr");
+  int bins = 0, within3 = 0, tail = 0;
+  double worst = 0, tail_z = 0;
+  for (std::size_t b = 0; b < profile.radial.size(); ++b) {
+    for (int c = 0; c < 3; ++c) {
+      double sum = 0, se2 = 0;
+      int n = 0;
+      for (int j = 0; j < truth.height; ++j) {
+        for (int i = 0; i < truth.width; ++i) {
+          const double r = 0.25 * std::hypot(i + 0.5 - profile.beam_point_px[0],
+                                             j + 0.5 - profile.beam_point_px[1]);
+          const bool last = b + 1 == profile.radial.size();
+          if (r >= profile.radial.r_inner_mm[b] &&
+              (r < profile.radial.r_outer_mm[b] || (last && r <= profile.radial.r_outer_mm[b]))) {
+            sum += truth.at(i, j, c);
+            se2 += double(truth_se.at(i, j, c)) * truth_se.at(i, j, c);
+            ++n;
+          }
+        }
+      }
+      if (n != profile.radial.count[c][b]) continue;  // a masked pixel changed the set
+      const double expected = std::numbers::pi * sum / n;
+      const double value = profile.radial.value[c][b];
+      const double se = std::sqrt(std::pow(profile.radial.standard_error[c][b], 2) +
+                                  std::pow(std::numbers::pi * std::sqrt(se2) / n, 2) +
+                                  std::pow(0.01 * expected, 2));  // calibration, ~0.3-1%
+      const double z = (value - expected) / se;
+      ++bins;
+      within3 += std::abs(z) < 3;
+      worst = std::max(worst, std::abs(z));
+      // The faint tail, where a floor would show: the truth below 1e-4 of the bin nearest the beam.
+      if (expected < 1e-4 * profile.radial.value[c][0]) ++tail, tail_z += z;
+    }
+  }
+  EXPECT_GT(bins, 200);
+  EXPECT_GE(within3, 0.99 * bins) << within3 << " of " << bins << " bins within 3 SE";
+  EXPECT_LT(worst, 4.5);
+  if (tail > 10) {
+    // No floor: the tail's mean z is noise, |mean| < 3 / sqrt(n) (a floor made it ~+3 or more).
+    EXPECT_LT(std::abs(tail_z / tail), 3.0 / std::sqrt(double(tail)))
+        << name << ": mean z over " << tail << " faint bins";
+  }
+  fs::remove_all(sim);
+  fs::remove_all(acq);
+}
+
+INSTANTIATE_TEST_SUITE_P(Materials, ProfileWithoutBias,
+                         ::testing::Values("skin1", "marble", "ketchup"));
 }  // namespace
 }  // namespace lucent::acquire

@@ -83,12 +83,32 @@ TEST_P(ExactRecovery, BothModelsFromStartValuesTenTimesOff) {
 INSTANTIATE_TEST_SUITE_P(Bundled, ExactRecovery,
                          ::testing::ValuesIn(materials::library_material_names()));
 
-TEST(Fit, AutoKeepsTheDipoleForDipoleDataAndTakesTheDdipoleForDdipoleData) {
+TEST(Fit, AutoFitsTheTabulatedModelAndJudgesTheDipolesAgainstIt) {
   const materials::Material m = materials::load_material("potato");
+  const FitResult r = fit_profiles({model_profile(m, FitModel::kDipole)}, FitOptions{});
+  EXPECT_EQ(r.chosen.model, FitModel::kTabulated) << r.reason;
+  ASSERT_EQ(r.candidates.size(), 3u);
+  EXPECT_EQ(r.candidates[1].model, FitModel::kDipole);
+  ASSERT_EQ(r.adequacy.size(), 2u);
+  EXPECT_FALSE(r.adequate_model.empty());
+  // The dipole candidate carries its difference from the tabulated fit as a systematic.
+  for (int c = 0; c < 3; ++c) {
+    const ChannelFit& d = r.candidates[1].channels[c];
+    EXPECT_NEAR(d.sd_sys_sigma_a, std::abs(d.sigma_a - r.chosen.channels[c].sigma_a), 1e-15);
+    EXPECT_GE(d.sd_sigma_a, d.sd_stat_sigma_a);
+    EXPECT_NEAR(d.sd_sigma_a, std::hypot(d.sd_stat_sigma_a, d.sd_sys_sigma_a), 1e-15);
+  }
+}
+
+TEST(Fit, WithoutAnAccurateModelAutoKeepsTheSimplerDiffusionModel) {
+  // eta 2 lies outside the shipped table (1.0-1.6): the choice between the dipoles is the data's.
+  materials::Material m = materials::load_material("potato");
+  m.ior = 2.0;
   FitOptions o;
   o.exclude_radius_mm = 0;
   const FitResult from_dipole = fit_profiles({model_profile(m, FitModel::kDipole)}, o);
   EXPECT_EQ(from_dipole.chosen.model, FitModel::kDipole) << from_dipole.reason;
+  EXPECT_NE(from_dipole.reason.find("no accurate model"), std::string::npos) << from_dipole.reason;
   const FitResult from_ddipole = fit_profiles({model_profile(m, FitModel::kDirectionalDipole)}, o);
   EXPECT_EQ(from_ddipole.chosen.model, FitModel::kDirectionalDipole) << from_ddipole.reason;
   EXPECT_EQ(from_ddipole.candidates.size(), 2u);

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -11,18 +12,34 @@
 #include "lucent/fit/fit_data.h"
 #include "lucent/materials/material.h"
 
+namespace lucent::materials {
+class TabulatedProfile;
+struct TransportTable;
+}  // namespace lucent::materials
+
 namespace lucent::fit {
 
-enum class FitModel { kDipole, kDirectionalDipole, kAuto };
+/// kTabulated: the transport table (DESIGN §4.2), exact to radiative transfer for radial profiles
+/// at normal incidence and normal view. kAuto: the accurate model the data allows (tabulated for
+/// radial data, the directional dipole for oblique 2D data), then which cheaper model is adequate.
+enum class FitModel { kDipole, kDirectionalDipole, kTabulated, kAuto };
+std::string to_string(FitModel model);
 enum class Quality { kFast, kBalanced, kAccurate };
 enum class LossKind { kNone, kHuber, kCauchy };
 
 struct FitOptions {
   FitModel model = FitModel::kAuto;
-  /// Bins (and 2D samples) closer to the entry point than this are left out (single scattering and
-  /// the specular peak live there), mm. Unset: one transport mean free path 1 / sigma_t', estimated
-  /// from the data's start values.
+  /// Bins (and 2D samples) closer to the entry point than this are left out, mm, in every channel.
+  /// Unset: per channel from its own data: for the diffusion models one transport mean free path
+  /// 1 / sigma_t' (single scattering, which they lack, lives inside it); for the tabulated model,
+  /// which has it, two pixels (the footprint quadrature cannot follow the 1/r peak) or
+  /// 0.1 / sigma_t'.
   std::optional<double> exclude_radius_mm;
+  /// Henyey-Greenstein g the tabulated model assumes (radial normal-incidence data cannot separate
+  /// g from sigma_s; the report says how far the answer moves between g = 0 and 0.9).
+  double g = 0;
+  /// The transport table; null: the shipped one (materials::default_transport_table()).
+  const materials::TransportTable* table = nullptr;
   std::optional<double> ior;     ///< relative index; required unless the data carries it or fit_ior
   bool fit_ior = false;          ///< fit eta too (one for all channels)
   std::optional<bool> relative;  ///< fit a global scale; default: when the data is uncalibrated
@@ -50,8 +67,21 @@ struct QualitySettings {
 QualitySettings quality_settings(Quality quality);
 
 struct ChannelFit {
-  double sigma_a = 0, sigma_s_reduced = 0;        ///< mm^-1
-  double sd_sigma_a = 0, sd_sigma_s_reduced = 0;  ///< standard deviations, mm^-1 (0 when fixed)
+  double sigma_a = 0, sigma_s_reduced = 0;  ///< mm^-1
+  /// Total standard deviations, mm^-1 (0 when fixed): statistical and systematic in quadrature.
+  double sd_sigma_a = 0, sd_sigma_s_reduced = 0;
+  /// Statistical: from the Jacobian (calibration priors included), scaled by sqrt(reduced chi^2)
+  /// when it exceeds 1 (lack of fit).
+  double sd_stat_sigma_a = 0, sd_stat_sigma_s_reduced = 0;
+  /// Systematic: the model's own error; for a diffusion model its difference from the tabulated
+  /// model on the same data (0 for the tabulated model, whose table error enters the statistical
+  /// part through the weights).
+  double sd_sys_sigma_a = 0, sd_sys_sigma_s_reduced = 0;
+  double reduced_chi2 = 0;
+  /// This channel's usable range: exclusion radius and the last bin above the noise floor, mm.
+  double exclude_radius_mm = 0, range_end_mm = 0;
+  /// The usable range in diffuse mean free paths 1 / sigma_tr (the fit's sigma_tr).
+  double range_diffusion_lengths = 0;
   double correlation = 0;                         ///< between sigma_a and sigma_s'
   double start_sigma_a = 0, start_sigma_s_reduced = 0;
   int samples = 0;          ///< residuals used
@@ -78,12 +108,34 @@ struct ModelFit {
   std::string message;                    ///< Ceres' termination message
 };
 
+/// How well a cheaper model reproduces the chosen (accurate) material: its profile evaluated with
+/// the chosen coefficients against the chosen model's, over the data's radii.
+struct ModelAdequacy {
+  FitModel model = FitModel::kDipole;
+  double tolerance = 0.03;  ///< relative
+  /// Beyond this radius (mm) the cheaper profile stays within `tolerance` in every channel up to
+  /// the end of the data; infinity when it never does.
+  double beyond_mm = 0;
+  double max_deviation = 0;  ///< worst relative deviation beyond the exclusion radius
+  bool adequate = false;     ///< within tolerance beyond a radius inside the data
+};
+
 struct FitResult {
   ModelFit chosen;
-  std::vector<ModelFit> candidates;  ///< every model fitted (auto: both)
+  std::vector<ModelFit> candidates;  ///< every model fitted (auto: accurate first)
   std::string reason;                ///< why this model
-  double exclude_radius_mm = 0;
-  std::vector<std::string> notes;  ///< assumptions worth saying (assumed errors, ...)
+  double exclude_radius_mm = 0;      ///< the smallest of the channels' exclusion radii
+  std::vector<std::string> notes;     ///< assumptions worth saying (assumed errors, ...)
+  std::vector<std::string> warnings;  ///< results to distrust (short range, parameters at bounds)
+  std::vector<ModelAdequacy> adequacy;  ///< cheaper models against the chosen one
+  std::string adequate_model;           ///< the cheapest adequate one ("" when none)
+  double g = 0;                         ///< the g the tabulated model assumed
+  /// Per channel {sigma_a, sigma_s'} of the tabulated fit at g = g_other (0.9, or 0 when the fit
+  /// assumed g >= 0.45): how far the answer moves with the assumed g. Empty when not computed.
+  std::vector<std::array<double, 2>> g_09;
+  double g_other = 0.9;
+  /// The tabulated profile the fit used (for plots); null when none.
+  std::shared_ptr<const materials::TabulatedProfile> table;
 };
 
 /// Fits one or more profiles of one material jointly.

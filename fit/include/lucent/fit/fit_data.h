@@ -43,18 +43,27 @@ struct ProfileData {
   double incidence_polar_deg = 0;
   double incidence_azimuth_deg = 0;  ///< direction of travel from +x
   double view_deg = 0;
-  /// Exitance per unit power entering (CSV, Monte Carlo tallies) rather than pi L / P from a
-  /// camera.
+  /// Exitance (power per unit area, all directions: Monte Carlo tallies, CSV) rather than pi L
+  /// along the view direction (a camera, or a CSV that says quantity=radiance).
   bool exitance = false;
+  /// Values per unit power incident on the sample (a camera; lucent simulate's exitance CSV)
+  /// rather than per unit power entering it (lucent profile's CSV, and CSV by default).
+  bool per_incident_power = true;
   RadialBins radial;
   std::optional<Samples2d> samples_2d;
   std::array<bool, 3> channels{true, true, true};  ///< which channels carry data
+  std::vector<std::string> notes;  ///< what the reader assumed or skipped, for the report
 };
 
-/// Reads a `lucent-profile` JSON (from lucent acquire) or a CSV with header `r_mm` and value
-/// columns `R` or `R_r,R_g,R_b`, optional `se` / `se_r,se_g,se_b` and `r_inner_mm,r_outer_mm`. CSV
-/// values are per mm^2 per unit power entering; without se columns a 5% relative error is assumed
-/// (and said in the report). Throws lucent::Error with one line naming the file, line or field.
+/// Reads a `lucent-profile` JSON (from lucent acquire) or lucent's radial CSV: optional leading
+/// `#` lines of `key=value` tokens (`ior=` or `eta=` the relative index, `quantity=exitance|
+/// radiance`, `R_unit=..._per_unit_incident_power`, `incidence_deg=`; what `lucent profile` and
+/// `lucent simulate --exitance-csv` write), the header `r_mm` and value columns `R` or
+/// `R_r,R_g,R_b`, optional `se` / `se_r,se_g,se_b` and `r_inner_mm,r_outer_mm`. CSV values are per
+/// mm^2 per unit power entering unless the comments say otherwise; without se columns a 5%
+/// relative error is assumed (a note says so); rows whose standard error is 0 (no Monte Carlo
+/// photon arrived) are skipped and counted. Throws lucent::Error with one line naming the file,
+/// line or field.
 ProfileData load_profile_data(const std::filesystem::path& path);
 
 }  // namespace lucent::fit

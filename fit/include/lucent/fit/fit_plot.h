@@ -13,6 +13,7 @@ void write_fit_plot(const std::filesystem::path& path, const FitResult& result,
 
 /// The fitted model's prediction (pi L / P per mm^2 including both Fresnel transmittances and the
 /// global scale) at radius r at normal incidence on a plane, channel c.
-double predicted_radial(const ModelFit& fit, const ProfileData& data, int channel, double r_mm);
+double predicted_radial(const ModelFit& fit, const ProfileData& data, int channel, double r_mm,
+                        const materials::TabulatedProfile* table = nullptr);
 
 }  // namespace lucent::fit

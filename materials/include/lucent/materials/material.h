@@ -25,12 +25,22 @@ struct Material {
   Rgb sigma_s_reduced{};       ///< reduced scattering sigma_s (1 - g), mm^-1
   std::optional<Rgb> sigma_s;  ///< unreduced scattering, mm^-1 (with g)
   std::optional<Rgb> g;        ///< Henyey-Greenstein mean cosine
-  std::string model;           ///< the model it was fitted with ("dipole", "ddipole"), or ""
+  /// The model it was fitted with ("dipole", "ddipole", "tabulated"), or "".
+  std::string model;
+  /// For a tabulated fit: the cheapest diffusion model within 3% of the tabulated profile beyond a
+  /// radius the fit reports, or when none is, the closest one (provenance.fit.adequacy says how
+  /// close, and beyond which radius); what a renderer without the table uses. "" when not judged.
+  std::string adequate_model;
   nlohmann::json uncertainty;  ///< standard deviations and correlations; null when not fitted
   nlohmann::json provenance;   ///< source table or capture, fit statistics, tool version
 
   /// One channel (0 = R, 1 = G, 2 = B) as a Medium; isotropic when only sigma_s' is known.
   Medium<double> medium(int channel) const;
+
+  /// The diffusion model a renderer without the tabulated model should use: the fitted one, or
+  /// for a tabulated fit the adequate diffusion model (ddipole when none is adequate), or
+  /// `fallback` for a material that was not fitted.
+  std::string diffusion_model(const std::string& fallback = "ddipole") const;
 
   std::string to_string() const;
 };

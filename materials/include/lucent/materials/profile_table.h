@@ -8,14 +8,19 @@
 
 #include "lucent/materials/directional_dipole.h"
 #include "lucent/materials/material.h"
+#include "lucent/materials/transport_table.h"
 
 namespace lucent::materials {
 
-enum class DiffusionModel { kDipole, kDirectionalDipole };
+/// The models of a translucent material. kTabulated (the transport table, DESIGN §4.2) is radial
+/// only: normal incidence on a plane; the renderer has the two dipoles.
+enum class DiffusionModel { kDipole, kDirectionalDipole, kTabulated };
 
-/// "dipole" or "ddipole"; anything else throws lucent::Error naming the option.
+/// "dipole" or "ddipole" (and "tabulated" when allowed); anything else throws lucent::Error
+/// naming the option.
 DiffusionModel parse_diffusion_model(const std::string& name,
-                                     const std::string& option = "--model");
+                                     const std::string& option = "--model",
+                                     bool allow_tabulated = false);
 std::string to_string(DiffusionModel model);
 
 /// "0.1,0.5,1,2" -> radii in mm; each must be finite and >= 0.
@@ -26,16 +31,25 @@ std::vector<double> parse_radius_range(const std::string& text,
 
 struct RadialProfileOptions {
   DiffusionModel model = DiffusionModel::kDipole;
+  /// Exitance R(r), or pi L along the normal (what a camera looking straight down sees).
+  TableQuantity quantity = TableQuantity::kExitance;
   std::vector<double> r_mm;  ///< radii, mm
-  bool total = false;        ///< append the total diffuse reflectance per channel
+  bool total = false;        ///< add the total diffuse reflectance per channel
 };
 
-/// CSV `r_mm,Rd_r,Rd_g,Rd_b`: radially symmetric diffuse reflectance per mm^2 for unit incident
-/// flux. dipole: R_d(r). ddipole: pi S_d at normal incidence on a plane (light along the normal,
-/// x_o at distance r), the quantity the directional dipole puts in R_d's place. With `total`, a
-/// last row `total,...`: the closed form for the dipole, numerical quadrature over the plane for
-/// the ddipole.
+/// lucent's radial CSV (the one schema `lucent fit` reads, README "radial CSV"): a comment line
+/// `# format=lucent-radial-profile version=1 quantity=exitance|radiance ior=ETA model=... ...`,
+/// then `r_mm,R_r,R_g,R_b`, values per mm^2 per unit power entering the sample, normal incidence.
+/// exitance: dipole R_d(r); ddipole pi S_d times its hemispherical exit transmittance
+/// eta^2 (1 - F_dr); tabulated the transport table's exitance. radiance: the dipoles times
+/// F_t(normal) (pi S with the outgoing transmittance); tabulated its radiance along the normal.
+/// With `total`, a comment line `# total=R,G,B` (closed form for the dipole, quadrature for the
+/// ddipole, the table's total for tabulated; always the exitance total).
 std::string radial_profile_csv(const Material& material, const RadialProfileOptions& options);
+
+/// The radial value of one channel at r (mm) as radial_profile_csv writes it.
+double radial_profile_value(const Material& material, int channel, DiffusionModel model,
+                            TableQuantity quantity, double r_mm);
 
 /// One BSSRDF configuration: positions in mm, unit normals and light direction.
 struct BssrdfConfig {

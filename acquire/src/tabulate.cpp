@@ -1,0 +1,346 @@
+// White Monte Carlo for the transport table (tabulate.h).
+//
+// The table is in optical units: sigma_t' = 1, so a medium of reduced albedo a has sigma_s' = a and
+// sigma_a = 1 - a. Scattering and absorption are independent events along a path, so a medium's
+// transport is its absorption-free twin (sigma_s' = a) with every path's weight multiplied by
+// e^(-sigma_a L). And the absorption-free medium of sigma_s' = a is the one of sigma_s' = 1 scaled
+// in length by 1 / a. So one run of the white medium (sigma_s' = 1, sigma_s = 1 / (1 - g), no
+// absorption) serves every albedo: a photon event at radius rho_w after a path L_w counts for the
+// medium of albedo a at radius rho_w / a with weight e^(-c L_w), c = (1 - a) / a (path lengths in
+// the white medium's units, where 1 / a of them make one unit of the real medium's, times 1 - a).
+// Binning happens in the real medium's radii, so nothing else rescales.
+//
+// Tallies per photon: its escape through the surface (exitance, with stochastic Fresnel
+// reflection as in the capture simulator) and, at every scattering event, the next-event estimate
+// of the radiance leaving along the normal: p_HG(d . z) e^(-sigma_s depth) T(0) / eta^2, with the
+// absorption of the path to the event and of the way up. The u nodes are walked in order of
+// growing c; once c L passes 40 (e^-40 = 4e-18 of the weight) the rest are skipped, so a long
+// path touches only the high-albedo nodes it matters for.
+//
+// Standard errors come from `groups` independent photon groups per slice (the spread of the group
+// means), which is also what makes the table shardable: a shard computes some (slice, group)
+// units, a merge puts them together, and the finishing step is the same for both.
+#include "lucent/acquire/tabulate.h"
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <mutex>
+#include <numbers>
+#include <string>
+#include <thread>
+
+#include "lucent/materials/error.h"
+#include "lucent/materials/fresnel.h"
+#include "lucent/version.h"
+#include "monte_carlo_random.h"
+
+namespace lucent::acquire {
+namespace {
+
+using detail::HenyeyGreenstein;
+using detail::Xoshiro256StarStar;
+
+constexpr double kMaxOpticalWeightExponent = 40;  // e^-40: below anything a table entry can see
+
+struct SliceConstants {
+  double eta = 1, g = 0;
+  double sigma_s = 1;     // white medium, units of sigma_s' = 1
+  double eta_out = 1;     // 1 / eta
+  double nee_factor = 1;  // T(normal, going out) / eta^2
+  HenyeyGreenstein hg;
+};
+
+// Nodes of alpha' below this get a direct (absorbing) run: white Monte Carlo samples them through
+// the rare short paths only (a real path of a few mean free paths is a white path of a few times
+// alpha'), while the direct walk there is short and cheap.
+constexpr double kDirectBelowAlbedo = 0.4;
+
+struct AlbedoNode {
+  double alpha_prime = 1;
+  bool white = true;
+  double c = 0;      // (1 - a) / a
+  double shift = 0;  // bin index offset: -log10(a) * per_decade - log10(rho_min) * per_decade
+};
+
+std::uint64_t slice_seed(std::uint64_t seed, double eta, double g, int group) {
+  const std::uint64_t h = detail::mix64(std::bit_cast<std::uint64_t>(eta)) ^
+                          detail::mix64(std::bit_cast<std::uint64_t>(g) + 0x9e37);
+  return detail::stream_seed(seed ^ h, 7, static_cast<std::uint64_t>(group));
+}
+
+// One medium as a walker sees it, in units of sigma_t' = 1 (or of sigma_s' = 1 for the white run).
+struct Walk {
+  double sigma_t = 1;
+  double albedo = 1;  // single-scattering albedo; 1 in the white run
+  const SliceConstants* slice = nullptr;
+};
+
+// Traces one photon from the entry point straight down: calls escape(rho, path, weight) when it
+// leaves through the surface and event(rho, path, depth, weight, cos_up) at each collision before
+// it scatters (weight before the implicit capture). Stops at max_path, or when Russian roulette
+// (below a weight of 1e-4, survival 1/10) ends an absorbing walk.
+template <typename Escape, typename Event>
+void walk_photon(const Walk& m, Xoshiro256StarStar& rng, double max_path, Escape&& escape,
+                 Event&& event) {
+  const detail::ExponentialZiggurat& exponential = detail::exponential_ziggurat();
+  const SliceConstants& s = *m.slice;
+  const double inv_sigma_t = 1.0 / m.sigma_t;
+  double x = 0, y = 0, z = 0, ux = 0, uy = 0, uz = -1, w = 1, path = 0;
+  for (;;) {
+    double step = exponential.sample(rng) * inv_sigma_t;
+    while (uz > 0 && z + uz * step >= 0) {  // reaches the surface before the next collision
+      const double d = -z / uz;
+      if (step < d) break;
+      x += ux * d;
+      y += uy * d;
+      z = 0;
+      path += d;
+      step -= d;
+      const double R = materials::fresnel_reflectance(uz, s.eta_out);
+      if (R < 1 && !(rng.uniform() < R)) {
+        escape(std::sqrt(x * x + y * y), path, w);
+        return;
+      }
+      uz = -uz;
+    }
+    x += ux * step;
+    y += uy * step;
+    z += uz * step;
+    path += step;
+    if (path > max_path) return;
+    event(std::sqrt(x * x + y * y), path, -z, w, uz);
+    if (m.albedo < 1) {
+      w *= m.albedo;
+      if (w < 1e-4) {
+        if (!(rng.uniform() < 0.1)) return;
+        w *= 10;
+      }
+    }
+    detail::scatter_henyey_greenstein(s.hg, rng, ux, uy, uz);
+  }
+}
+
+// One (slice, group) unit: the white run for the nodes of alpha' >= kDirectBelowAlbedo, a direct
+// (absorbing) run for each node below it.
+void trace_group(const SliceConstants& s, const std::vector<AlbedoNode>& nodes,
+                 const materials::TransportTableGrid& grid, double max_path,
+                 std::uint64_t photons, Xoshiro256StarStar& rng,
+                 materials::TransportTableGroup& out, std::atomic<std::uint64_t>& done) {
+  const int J = grid.rho_bins();
+  const std::size_t K = nodes.size();
+  const double per_decade = grid.rho_per_decade;
+  const double log_rho_min = std::log10(grid.rho_min) * per_decade;
+  std::vector<double>& exitance = out.value[0];
+  std::vector<double>& radiance = out.value[1];
+  exitance.assign(K * std::size_t(J), 0.0);
+  radiance.assign(K * std::size_t(J), 0.0);
+  out.total.assign(K, 0.0);
+  std::size_t white_nodes = 0;
+  while (white_nodes < K && nodes[white_nodes].white) ++white_nodes;
+
+  // White run: each event counts for every white node k at radius rho_w / a_k with e^(-c_k L).
+  const auto score = [&](std::vector<double>* tally, double rho_w, double path, double weight) {
+    const double lr = rho_w > 0 ? std::log10(rho_w) * per_decade : -1e300;
+    for (std::size_t k = 0; k < white_nodes; ++k) {
+      const double exponent = nodes[k].c * path;
+      if (exponent > kMaxOpticalWeightExponent) break;
+      const double w = weight * std::exp(-exponent);
+      if (!tally) {
+        out.total[k] += w;
+        continue;
+      }
+      const double fj = lr + nodes[k].shift;
+      if (fj < 0 || fj >= J) continue;
+      (*tally)[k * std::size_t(J) + std::size_t(fj)] += w;
+    }
+  };
+  const Walk white{s.sigma_s, 1.0, &s};
+  for (std::uint64_t n = 0; n < photons; ++n) {
+    walk_photon(
+        white, rng, max_path,
+        [&](double rho, double path, double) {
+          score(&exitance, rho, path, 1.0);
+          score(nullptr, rho, path, 1.0);
+        },
+        [&](double rho, double path, double depth, double, double cos_up) {
+          // Next-event estimate of the radiance leaving along the normal.
+          if (s.sigma_s * depth < kMaxOpticalWeightExponent) {
+            const double v = s.nee_factor * s.hg.pdf(cos_up) * std::exp(-s.sigma_s * depth);
+            score(&radiance, rho, path + depth, v);
+          }
+        });
+    if ((n & 1023) == 1023) done.fetch_add(1024, std::memory_order_relaxed);
+  }
+  done.fetch_add(photons & 1023, std::memory_order_relaxed);
+
+  // Direct runs: the absorbing medium itself, sigma_t' = 1, binned as it is.
+  for (std::size_t k = white_nodes; k < K; ++k) {
+    const double a = nodes[k].alpha_prime;
+    const double sigma_s = a / (1 - s.g);
+    const Walk direct{(1 - a) + sigma_s, sigma_s / ((1 - a) + sigma_s), &s};
+    const auto bin = [&](double rho) {
+      const double fj = (rho > 0 ? std::log10(rho) * per_decade : -1e300) - log_rho_min;
+      return fj >= 0 && fj < J ? int(fj) : -1;
+    };
+    for (std::uint64_t n = 0; n < photons; ++n) {
+      walk_photon(
+          direct, rng, max_path,
+          [&](double rho, double, double w) {
+            out.total[k] += w;
+            if (const int j = bin(rho); j >= 0) exitance[k * std::size_t(J) + std::size_t(j)] += w;
+          },
+          [&](double rho, double, double depth, double w, double cos_up) {
+            const double tau = direct.sigma_t * depth;
+            if (tau >= kMaxOpticalWeightExponent) return;
+            if (const int j = bin(rho); j >= 0)
+              radiance[k * std::size_t(J) + std::size_t(j)] +=
+                  w * direct.albedo * s.nee_factor * s.hg.pdf(cos_up) * std::exp(-tau);
+          });
+    }
+  }
+
+  // Means per photon, per unit area of the real medium's annuli; pi L for the radiance.
+  for (std::size_t k = 0; k < K; ++k) {
+    for (int j = 0; j < J; ++j) {
+      const double r0 = grid.rho_edge(j), r1 = grid.rho_edge(j + 1);
+      const double area = std::numbers::pi * (r1 * r1 - r0 * r0);
+      exitance[k * std::size_t(J) + std::size_t(j)] /= double(photons) * area;
+      radiance[k * std::size_t(J) + std::size_t(j)] *= std::numbers::pi / (double(photons) * area);
+    }
+    out.total[k] /= double(photons);
+  }
+}
+
+}  // namespace
+
+void validate_tabulate_options(const TabulateOptions& o) {
+  const auto bad = [](const std::string& what) { throw Error(what); };
+  if (o.eta.empty()) bad("--eta: at least one relative index is needed");
+  for (double e : o.eta)
+    if (!(e >= 1.0 && e <= 2.5)) bad("--eta: each relative index must be in [1, 2.5]");
+  if (o.g.empty()) bad("--g: at least one anisotropy is needed");
+  for (double g : o.g)
+    if (!(g >= 0.0 && g <= 0.95)) bad("--g: each Henyey-Greenstein g must be in [0, 0.95]");
+  for (std::size_t i = 1; i < o.eta.size(); ++i)
+    if (!(o.eta[i] > o.eta[i - 1])) bad("--eta: the indices must be strictly increasing");
+  for (std::size_t i = 1; i < o.g.size(); ++i)
+    if (!(o.g[i] > o.g[i - 1])) bad("--g: the values must be strictly increasing");
+  if (o.grid.u.size() < 2 || o.grid.u.front() != 0.0) bad("grid: u nodes must start at 0");
+  for (std::size_t i = 1; i < o.grid.u.size(); ++i)
+    if (!(o.grid.u[i] > o.grid.u[i - 1] && o.grid.u[i] < 1)) bad("grid: u nodes must rise in [0, 1)");
+  if (!(o.grid.rho_min > 0 && o.grid.rho_max > o.grid.rho_min && o.grid.rho_per_decade >= 1 &&
+        o.grid.rho_per_decade <= 200))
+    bad("grid: rho range or bins per decade out of range");
+  if (o.groups < 2 || o.groups > 1024) bad("--groups: expected 2..1024 photon groups");
+  if (o.photons < std::uint64_t(o.groups) || o.photons > 1'000'000'000'000ULL)
+    bad("--photons: expected at least one photon per group and at most 1e12");
+  if (o.threads < 0 || o.threads > 1024) bad("--threads: expected 0 (all cores) to 1024");
+  if (!(o.max_path >= 10 && o.max_path <= 1e9)) bad("--max-path: expected 10..1e9");
+  if (o.shard_count < 1 || o.shard_index < 0 || o.shard_index >= o.shard_count)
+    bad("--shard: expected I/N with 0 <= I < N");
+}
+
+materials::TransportTable tabulate_transport(const TabulateOptions& o,
+                                             const TabulateProgress& progress) {
+  validate_tabulate_options(o);
+  materials::TransportTable table;
+  table.grid = o.grid;
+  table.seed = o.seed;
+  table.groups = o.groups;
+  table.max_path = o.max_path;
+  table.generator = std::string("lucent ") + kVersion;
+  const std::uint64_t per_group = (o.photons + std::uint64_t(o.groups) - 1) / std::uint64_t(o.groups);
+
+  std::vector<SliceConstants> slices;
+  for (double g : o.g) {
+    for (double eta : o.eta) {
+      SliceConstants s;
+      s.eta = eta;
+      s.g = g;
+      s.sigma_s = 1.0 / (1.0 - g);
+      s.eta_out = 1.0 / eta;
+      s.nee_factor = materials::fresnel_transmittance(1.0, s.eta_out) / (eta * eta);
+      s.hg = HenyeyGreenstein(g);
+      slices.push_back(s);
+      table.slice_axes.push_back({eta, g, double(per_group * std::uint64_t(o.groups))});
+    }
+  }
+  std::vector<AlbedoNode> nodes;
+  for (double u : o.grid.u) {
+    const double a = 1 - u * u;
+    AlbedoNode n;
+    n.alpha_prime = a;
+    n.white = a >= kDirectBelowAlbedo;
+    n.c = (1 - a) / a;
+    n.shift = (-std::log10(a) - std::log10(o.grid.rho_min)) * o.grid.rho_per_decade;
+    nodes.push_back(n);
+  }
+
+  // This shard's units, in (slice, group) order.
+  std::vector<std::pair<int, int>> units;
+  for (int s = 0; s < int(slices.size()); ++s)
+    for (int g = 0; g < o.groups; ++g)
+      if ((s * o.groups + g) % o.shard_count == o.shard_index) units.emplace_back(s, g);
+  std::vector<materials::TransportTableGroup> results(units.size());
+  const std::uint64_t total = per_group * units.size();
+
+  std::atomic<std::uint64_t> done{0};
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> failed{false};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  const auto worker = [&] {
+    for (;;) {
+      const std::size_t i = next.fetch_add(1);
+      if (i >= units.size() || failed) return;
+      try {
+        const auto [s, g] = units[i];
+        Xoshiro256StarStar rng(slice_seed(o.seed, slices[s].eta, slices[s].g, g));
+        results[i].slice = s;
+        results[i].group = g;
+        trace_group(slices[s], nodes, o.grid, o.max_path, per_group, rng, results[i], done);
+      } catch (...) {
+        std::lock_guard lock(error_mutex);
+        if (!error) error = std::current_exception();
+        failed = true;
+      }
+    }
+  };
+  int threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+  threads = std::min<int>(threads, int(std::max<std::size_t>(1, units.size())));
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
+  // The calling thread reports progress until the workers are done (callbacks from one thread).
+  for (;;) {
+    const bool finished = next.load() >= units.size() + std::size_t(threads);
+    if (progress) {
+      try {
+        progress(std::min(done.load(), total), total);
+      } catch (...) {
+        std::lock_guard lock(error_mutex);
+        if (!error) error = std::current_exception();
+        failed = true;
+      }
+    }
+    if (finished || failed) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(250));
+  }
+  for (auto& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
+  if (progress) progress(total, total);
+
+  if (o.shard_count > 1) {
+    table.partial = true;
+    table.shard = std::to_string(o.shard_index) + "/" + std::to_string(o.shard_count);
+    table.partial_groups = std::move(results);
+    return table;
+  }
+  materials::finish_transport_table(table, results);
+  return table;
+}
+
+}  // namespace lucent::acquire

@@ -1,0 +1,136 @@
+// `lucent tabulate`: builds the transport table of the tabulated model (white Monte Carlo), or a
+// shard of it for a cluster's job array, or merges shards.
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "commands.h"
+#include "lucent/acquire/tabulate.h"
+#include "lucent/materials/error.h"
+#include "lucent/materials/profile_table.h"
+
+namespace lucent::cli {
+namespace {
+
+struct TabulateArguments {
+  std::string output;
+  std::string eta = "1.0,1.1,1.2,1.3,1.4,1.5,1.6";
+  std::string g = "0";
+  std::string shard;
+  std::vector<std::string> merge;
+  bool quiet = false;
+  acquire::TabulateOptions options;
+};
+
+std::vector<double> parse_list(const std::string& text, const std::string& option) {
+  std::vector<double> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    try {
+      std::size_t used = 0;
+      const double v = std::stod(item, &used);
+      if (used != item.size() || !std::isfinite(v)) throw std::invalid_argument(item);
+      out.push_back(v);
+    } catch (const std::exception&) {
+      throw Error(option + ": expected a comma-separated list of numbers, got '" + item + "'");
+    }
+  }
+  return out;
+}
+
+std::string duration(double seconds) {
+  std::ostringstream s;
+  if (seconds >= 3600) s << int(seconds / 3600) << " h ";
+  if (seconds >= 60) s << int(std::fmod(seconds, 3600) / 60) << " min ";
+  s << int(std::fmod(seconds, 60)) << " s";
+  return s.str();
+}
+
+void run(TabulateArguments& args) {
+  if (!args.merge.empty()) {
+    std::vector<materials::TransportTable> parts;
+    for (const std::string& p : args.merge) parts.push_back(materials::read_transport_table(p));
+    const materials::TransportTable table = materials::merge_transport_tables(parts);
+    materials::write_transport_table(table, args.output);
+    if (!args.quiet)
+      std::cout << "merged " << parts.size() << " shards into " << args.output << " ("
+                << table.slices.size() << " slices)\n";
+    return;
+  }
+  acquire::TabulateOptions& o = args.options;
+  o.eta = parse_list(args.eta, "--eta");
+  o.g = parse_list(args.g, "--g");
+  if (!args.shard.empty()) {
+    const auto slash = args.shard.find('/');
+    try {
+      if (slash == std::string::npos) throw std::invalid_argument(args.shard);
+      std::size_t u1 = 0, u2 = 0;
+      const std::string a = args.shard.substr(0, slash), b = args.shard.substr(slash + 1);
+      o.shard_index = std::stoi(a, &u1);
+      o.shard_count = std::stoi(b, &u2);
+      if (u1 != a.size() || u2 != b.size()) throw std::invalid_argument(args.shard);
+    } catch (const std::exception&) {
+      throw Error("--shard: expected I/N (0-based shard I of N), got '" + args.shard + "'");
+    }
+  }
+  const auto start = std::chrono::steady_clock::now();
+  auto last = start;
+  const auto progress = [&](std::uint64_t done, std::uint64_t total) {
+    const auto now = std::chrono::steady_clock::now();
+    if (args.quiet || now - last < std::chrono::seconds(2) || done == 0) return;
+    last = now;
+    const double elapsed = std::chrono::duration<double>(now - start).count();
+    const double left = elapsed * double(total - done) / double(done);
+    std::cerr << "\rtabulate: " << (100 * done / std::max<std::uint64_t>(total, 1)) << "% of "
+              << total << " photons, " << duration(left) << " left   " << std::flush;
+  };
+  const materials::TransportTable table = acquire::tabulate_transport(o, progress);
+  materials::write_transport_table(table, args.output);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!args.quiet) {
+    if (last != start) std::cerr << "\r" << std::string(60, ' ') << "\r";
+    std::cout << "wrote " << (table.partial ? "shard " + table.shard + " " : std::string())
+              << args.output << ": " << table.slice_axes.size() << " slices (eta x g), "
+              << table.grid.u.size() << " albedos x " << table.grid.rho_bins() << " radii, "
+              << std::uint64_t(table.slice_axes.front()[2]) << " photons per slice, in "
+              << duration(seconds) << '\n';
+  }
+}
+
+}  // namespace
+
+void register_tabulate_command(CLI::App& app) {
+  auto args = std::make_shared<TabulateArguments>();
+  auto& o = args->options;
+  CLI::App* cmd = app.add_subcommand(
+      "tabulate",
+      "Builds the transport table of --model tabulated: the radial exitance and normal radiance "
+      "of a semi-infinite slab under a normal pencil beam, per unit power entering, in optical "
+      "units (r sigma_t', alpha'), per eta and g, by white Monte Carlo (one absorption-free run "
+      "serves every albedo). Deterministic for a seed; --shard I/N builds a part for a job "
+      "array, --merge joins the parts.");
+  cmd->add_option("-o,--output", args->output, "table file to write (atomically)")->required();
+  cmd->add_option("--eta", args->eta, "relative indices, increasing, in [1, 2.5]")
+      ->capture_default_str();
+  cmd->add_option("--g", args->g, "Henyey-Greenstein g values, increasing, in [0, 0.95]")
+      ->capture_default_str();
+  cmd->add_option("--photons", o.photons, "photons per (eta, g) slice")->capture_default_str();
+  cmd->add_option("--seed", o.seed, "random seed (same table for any --threads or sharding)")
+      ->capture_default_str();
+  cmd->add_option("--threads", o.threads, "worker threads (0 = all cores)")->capture_default_str();
+  cmd->add_option("--groups", o.groups, "independent photon groups per slice (standard errors)")
+      ->capture_default_str();
+  cmd->add_option("--max-path", o.max_path, "paths cut at this length, units of 1/sigma_s'")
+      ->capture_default_str();
+  cmd->add_option("--shard", args->shard, "build shard I of N (0-based) as a partial table");
+  cmd->add_option("--merge", args->merge, "merge these tables into -o instead: the shards of one build, and finished tables of other slices (same grid)")
+      ->expected(1, -1);
+  cmd->add_flag("-q,--quiet", args->quiet, "no progress or summary");
+  cmd->callback([args] { run(*args); });
+}
+
+}  // namespace lucent::cli

@@ -1,0 +1,178 @@
+// Total uncertainty, warnings and model adequacy (fit_uncertainty.h).
+#include "fit_uncertainty.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+#include "model_prediction.h"
+
+namespace lucent::fit {
+
+std::string to_string(FitModel m) {
+  switch (m) {
+    case FitModel::kDipole: return "dipole";
+    case FitModel::kDirectionalDipole: return "ddipole";
+    case FitModel::kTabulated: return "tabulated";
+    case FitModel::kAuto: return "auto";
+  }
+  return "auto";
+}
+
+namespace detail {
+namespace {
+
+const char* kNames[3] = {"R", "G", "B"};
+
+std::string number(double v, int precision = 3) {
+  std::ostringstream s;
+  s.precision(precision);
+  s << v;
+  return s.str();
+}
+
+}  // namespace
+
+void finish_uncertainty(FitResult& result, const std::vector<ProfileData>& data,
+                        const FitOptions& options, const std::array<bool, 3>& channels) {
+  const ModelFit* accurate = nullptr;
+  for (const ModelFit& f : result.candidates)
+    if (f.model == FitModel::kTabulated) accurate = &f;
+  const ModelFit reference = accurate ? *accurate : ModelFit{};
+  const auto finish = [&](ModelFit& f) {
+    for (int c = 0; c < 3; ++c) {
+      ChannelFit& ch = f.channels[c];
+      if (accurate && f.model != FitModel::kTabulated) {
+        ch.sd_sys_sigma_a = std::abs(ch.sigma_a - reference.channels[c].sigma_a);
+        ch.sd_sys_sigma_s_reduced =
+            std::abs(ch.sigma_s_reduced - reference.channels[c].sigma_s_reduced);
+      }
+      ch.sd_sigma_a = std::hypot(ch.sd_stat_sigma_a, ch.sd_sys_sigma_a);
+      ch.sd_sigma_s_reduced = std::hypot(ch.sd_stat_sigma_s_reduced, ch.sd_sys_sigma_s_reduced);
+    }
+  };
+  for (ModelFit& f : result.candidates) finish(f);
+  finish(result.chosen);
+
+  const ModelFit& f = result.chosen;
+  for (int c = 0; c < 3; ++c) {
+    if (!channels[c]) continue;
+    const ChannelFit& ch = f.channels[c];
+    if (ch.range_diffusion_lengths < 3) {
+      const double sigma_tr = std::sqrt(3 * ch.sigma_a * (ch.sigma_a + ch.sigma_s_reduced));
+      result.warnings.push_back(
+          std::string("channel ") + kNames[c] + ": the usable range " +
+          number(ch.exclude_radius_mm) + ".." + number(ch.range_end_mm) + " mm spans only " +
+          number(ch.range_diffusion_lengths, 2) + " diffuse mean free paths (1/sigma_tr = " +
+          number(1 / sigma_tr) +
+          " mm; about 3 are needed to separate sigma_a from sigma_s'): distrust this channel, or "
+          "image farther out (larger field, longer exposure)");
+    }
+  }
+  if (options.fit_ior) {
+    const double lo = f.model == FitModel::kTabulated && result.table ? result.table->eta_min() : 1.0001;
+    const double hi = f.model == FitModel::kTabulated && result.table ? result.table->eta_max() : 2.5;
+    const bool edge = f.eta < lo + 0.005 || f.eta > hi - 0.005;
+    if (edge || !(f.sd_eta < 0.1 * f.eta)) {
+      const std::string why = edge ? "runs to the edge of its range " + number(lo) + ".." +
+                                         number(hi)
+                                   : "has a standard deviation of " + number(f.sd_eta);
+      result.warnings.push_back("eta is undetermined: the fitted " + number(f.eta, 4) + " " + why +
+                                "; radial profiles barely constrain it. Give --ior instead");
+      result.chosen.undetermined.push_back("eta");
+      for (ModelFit& candidate : result.candidates)
+        if (candidate.model == f.model) candidate.undetermined.push_back("eta");
+    }
+  }
+  (void)data;
+}
+
+void judge_adequacy(FitResult& result, const std::vector<ProfileData>& data,
+                    const std::array<bool, 3>& channels) {
+  const ModelFit& f = result.chosen;
+  if (!result.table || data.empty()) return;
+  const ProfileData& d = data.front();
+  CaptureGeometry g;
+  g.cos_incidence = std::cos(d.incidence_polar_deg * std::numbers::pi / 180);
+  g.cos_view = std::cos(d.view_deg * std::numbers::pi / 180);
+  g.exitance = d.exitance;
+  g.per_incident_power = d.per_incident_power;
+  const GaussLegendre gl = gauss_legendre(1);
+  for (FitModel m : {FitModel::kDipole, FitModel::kDirectionalDipole}) {
+    // Relative deviation of model m from the table, per channel, at 200 log-spaced radii over
+    // the channel's usable range.
+    std::vector<std::vector<std::pair<double, double>>> dev(3);
+    double reach = 0, max_deviation = 0;
+    for (int c = 0; c < 3; ++c) {
+      if (!channels[c]) continue;
+      const ChannelFit& ch = f.channels[c];
+      const materials::Medium<double> medium =
+          materials::Medium<double>::from_reduced(ch.sigma_a, ch.sigma_s_reduced, f.eta);
+      const double front_m = fresnel_factor(g, f.eta, m);
+      const double front_t = fresnel_factor(g, f.eta, FitModel::kTabulated);
+      reach = std::max(reach, ch.range_end_mm);
+      const double r0 = std::max(ch.exclude_radius_mm, 1e-3), r1 = std::max(ch.range_end_mm, r0);
+      for (int k = 0; k <= 200; ++k) {
+        const double r = r0 * std::pow(r1 / r0, k / 200.0);
+        const double vm = front_m * model_value(m, nullptr, medium, g, true, r, r, r, r, 0, 0, gl);
+        const double vt = front_t * model_value(FitModel::kTabulated, result.table.get(), medium,
+                                                g, true, r, r, r, r, 0, 0, gl);
+        const double d = vt > 0 ? std::abs(vm / vt - 1) : INFINITY;
+        dev[std::size_t(c)].emplace_back(r, d);
+        max_deviation = std::max(max_deviation, d);
+      }
+    }
+    // The tightest of a few tolerance bands the model keeps beyond some radius within the first
+    // half of the data's reach (3% is the bar for "adequate").
+    ModelAdequacy a;
+    a.model = m;
+    a.max_deviation = max_deviation;
+    a.beyond_mm = INFINITY;
+    for (double tolerance : {0.03, 0.05, 0.1, 0.2, 0.5}) {
+      double beyond = 0;
+      for (const auto& channel : dev) {
+        double last_bad = 0;
+        for (const auto& [r, d] : channel)
+          if (!(d <= tolerance)) last_bad = r;
+        if (!channel.empty() && last_bad >= channel.back().first * 0.999) last_bad = INFINITY;
+        beyond = std::max(beyond, last_bad);
+      }
+      a.tolerance = tolerance;
+      a.beyond_mm = beyond;
+      if (beyond <= 0.5 * reach) break;
+    }
+    a.adequate = a.tolerance <= 0.03 && a.beyond_mm <= 0.5 * reach;
+    std::ostringstream note;
+    note << to_string(m) << " with these coefficients: ";
+    if (a.beyond_mm <= 0.5 * reach) {
+      note << "within " << 100 * a.tolerance << "% of the tabulated profile "
+           << (a.beyond_mm > 0 ? "beyond " + number(a.beyond_mm) + " mm" : "over all the data")
+           << " (worst " << number(100 * a.max_deviation, 2) << "% closer in)"
+           << (a.adequate ? "; enough for scenes whose detail is coarser than " +
+                                number(std::max(a.beyond_mm, 1e-3)) + " mm"
+                          : "; not adequate at 3%");
+    } else {
+      note << "more than " << 100 * a.tolerance << "% off the tabulated profile over much of "
+           << "the data (worst " << number(100 * a.max_deviation, 2) << "%)";
+    }
+    result.notes.push_back(note.str());
+    result.adequacy.push_back(a);
+  }
+  // The cheapest adequate model; when none is within 3%, the closest diffusion model (tightest
+  // band, then smallest radius), which a renderer without the table should use.
+  const ModelAdequacy* best = nullptr;
+  for (const ModelAdequacy& a : result.adequacy) {
+    if (a.adequate) {
+      best = &a;
+      break;
+    }
+    if (!best || a.tolerance < best->tolerance ||
+        (a.tolerance == best->tolerance && a.beyond_mm < best->beyond_mm))
+      best = &a;
+  }
+  result.adequate_model = best ? to_string(best->model) : "";
+}
+
+}  // namespace detail
+}  // namespace lucent::fit

@@ -1,0 +1,237 @@
+// The tabulated model (DESIGN §4.2): a transport table interpolated C1-smoothly in log value over
+// log radius, u = sqrt(1 - alpha') and eta, templated on the scalar so that ceres::Jet carries
+// exact derivatives of the interpolant through a fit.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "lucent/materials/medium.h"
+#include "lucent/materials/transport_table.h"
+
+namespace lucent::materials {
+
+/// Cubic Hermite weights of the (up to) four nodes around t: the tangent at each node is the
+/// distance-weighted mean of its two neighbouring slopes (Catmull-Rom on a nonuniform grid), one-
+/// sided at the ends, so the interpolant is C1. Outside [nodes.front(), nodes.back()], linear
+/// extrapolation from the end cell (extrapolate) or the end value (clamp).
+template <typename T>
+struct NodeWeights {
+  int first = 0;  ///< index of w[0]'s node
+  int count = 0;
+  std::array<T, 4> w{};
+};
+
+template <typename T>
+NodeWeights<T> hermite_weights(const std::vector<double>& x, const T& t, bool extrapolate) {
+  NodeWeights<T> r;
+  const int n = int(x.size());
+  if (n == 1) {
+    r.count = 1;
+    r.w[0] = T(1);
+    return r;
+  }
+  if (!(t > T(x.front())) || !(t < T(x.back()))) {
+    const bool low = !(t > T(x.front()));
+    const int i = low ? 0 : n - 2;
+    r.first = i;
+    r.count = 2;
+    if (!extrapolate) {
+      r.w[low ? 0 : 1] = T(1);
+      r.w[low ? 1 : 0] = T(0);
+      return r;
+    }
+    const T s = (t - T(x[i])) / T(x[i + 1] - x[i]);
+    r.w[0] = T(1) - s;
+    r.w[1] = s;
+    return r;
+  }
+  int i = 0, hi = n - 1;  // x[i] <= t < x[i + 1]
+  while (hi - i > 1) {
+    const int mid = (i + hi) / 2;
+    if (t < T(x[mid]))
+      hi = mid;
+    else
+      i = mid;
+  }
+  const double h = x[i + 1] - x[i];
+  const T s = (t - T(x[i])) / T(h);
+  const T s2 = s * s, s3 = s2 * s;
+  const T h00 = T(2) * s3 - T(3) * s2 + T(1), h10 = s3 - T(2) * s2 + s;
+  const T h01 = T(-2) * s3 + T(3) * s2, h11 = s3 - s2;
+  // Weights on f[i-1], f[i], f[i+1], f[i+2].
+  std::array<T, 4> w{T(0), h00, h01, T(0)};
+  // Tangent at i (times h): on f[i-1], f[i], f[i+1].
+  if (i == 0) {
+    w[1] -= h10;
+    w[2] += h10;
+  } else {
+    const double hp = x[i] - x[i - 1];
+    const double a = hp / (hp + h);  // weight of the right slope
+    w[2] += h10 * T(a);
+    w[1] -= h10 * T(a);
+    w[1] += h10 * T((1 - a) * h / hp);
+    w[0] -= h10 * T((1 - a) * h / hp);
+  }
+  // Tangent at i + 1 (times h): on f[i], f[i+1], f[i+2].
+  if (i + 1 == n - 1) {
+    w[2] += h11;
+    w[1] -= h11;
+  } else {
+    const double hn = x[i + 2] - x[i + 1];
+    const double a = h / (h + hn);  // weight of the right slope
+    w[3] += h11 * T(a * h / hn);
+    w[2] -= h11 * T(a * h / hn);
+    w[2] += h11 * T(1 - a);
+    w[1] -= h11 * T(1 - a);
+  }
+  if (i == 0) {
+    r.first = 0;
+    r.count = 3;
+    r.w = {w[1], w[2], w[3], T(0)};
+    if (i + 1 == n - 1) r.count = 2;
+  } else {
+    r.first = i - 1;
+    r.count = i + 1 == n - 1 ? 3 : 4;
+    r.w = w;
+  }
+  return r;
+}
+
+/// A transport table at one g, ready to evaluate: log(value / alpha') at the point centres of the
+/// radius bins (the annulus averages of the file turned into point values by a second-order
+/// correction), per eta slice.
+class TabulatedProfile {
+ public:
+  /// The slices of `table` at anisotropy g: a g node, or C1 interpolation between g nodes (every g
+  /// node must have the same eta slices). Throws lucent::Error when g is outside the table.
+  TabulatedProfile(const TransportTable& table, double g);
+  /// The same profile with eta fixed (one slice: faster when eta is not fitted).
+  TabulatedProfile at_eta(double eta) const;
+
+  double g() const { return g_; }
+  double eta_min() const { return eta_.front(); }
+  double eta_max() const { return eta_.back(); }
+  const std::vector<double>& eta_nodes() const { return eta_; }
+  double u_max() const { return u_.back(); }
+  double rho_min() const { return rho_min_; }
+  double rho_max() const { return rho_max_; }
+  std::uint64_t photons() const { return photons_; }
+  std::string to_string() const;
+
+  /// log(value / (sigma_t'^2 alpha')) at rho = r sigma_t', u = sqrt(1 - alpha'), eta (clamped to
+  /// the table's range; u clamped to its last node, so below the table's smallest albedo the
+  /// value scales as alpha').
+  template <typename T>
+  T log_value(TableQuantity q, const T& rho, const T& u, const T& eta) const {
+    using std::log;
+    const NodeWeights<T> we = hermite_weights(eta_, eta, false);
+    const T uc = u < T(u_.back()) ? u : T(u_.back());
+    const NodeWeights<T> wu = hermite_weights(u_, uc, false);
+    const T lr = log(rho);
+    const auto at_x = [&](const NodeWeights<T>& wx) {
+      T sum(0);
+      for (int a = 0; a < we.count; ++a) {
+        const std::vector<double>& f = f_[std::size_t(we.first + a)][std::size_t(q)];
+        for (int b = 0; b < wu.count; ++b) {
+          const std::size_t row = std::size_t(wu.first + b) * std::size_t(J_);
+          T inner(0);
+          for (int c = 0; c < wx.count; ++c) inner += wx.w[c] * T(f[row + std::size_t(wx.first + c)]);
+          sum += we.w[a] * wu.w[b] * inner;
+        }
+      }
+      return sum;
+    };
+    if (lr > T(x_.back())) {
+      // Beyond the last bin: linear in rho (the far field falls as e^(-sigma_tr rho)).
+      NodeWeights<T> last, before;
+      last.first = J_ - 1, last.count = 1, last.w[0] = T(1);
+      before.first = J_ - 2, before.count = 1, before.w[0] = T(1);
+      const T f1 = at_x(last), f0 = at_x(before);
+      return f1 + (f1 - f0) / T(x_[std::size_t(J_) - 1] - x_[std::size_t(J_) - 2]) *
+                      (rho / T(std::exp(x_.back())) - T(1));
+    }
+    return at_x(hermite_weights(x_, lr, true));
+  }
+
+  /// value / sigma_t'^2 (exitance R, or pi L along the normal), per unit power entering.
+  template <typename T>
+  T value(TableQuantity q, const T& rho, const T& alpha_prime, const T& eta) const {
+    using std::exp;
+    using std::sqrt;
+    const T one_minus = T(1) - alpha_prime;
+    const T u = one_minus > T(0) ? sqrt(one_minus) : T(0);
+    return alpha_prime * exp(log_value(q, rho, u, eta));
+  }
+
+  /// Total diffuse reflectance per unit power entering.
+  template <typename T>
+  T total(const T& alpha_prime, const T& eta) const {
+    using std::exp;
+    using std::sqrt;
+    const T one_minus = T(1) - alpha_prime;
+    T u = one_minus > T(0) ? sqrt(one_minus) : T(0);
+    if (!(u < T(u_.back()))) u = T(u_.back());
+    const NodeWeights<T> we = hermite_weights(eta_, eta, false);
+    const NodeWeights<T> wu = hermite_weights(u_, u, false);
+    T sum(0);
+    for (int a = 0; a < we.count; ++a)
+      for (int b = 0; b < wu.count; ++b)
+        sum += we.w[a] * wu.w[b] * T(log_total_[std::size_t(we.first + a)][std::size_t(wu.first + b)]);
+    return alpha_prime * exp(sum);
+  }
+
+  /// The table's relative standard error near (rho, alpha', eta) (the largest of the entries the
+  /// interpolation leans on most); infinity in an extrapolated tail.
+  double relative_se(TableQuantity q, double rho, double alpha_prime, double eta) const;
+
+ private:
+  TabulatedProfile() = default;
+  double g_ = 0;
+  std::vector<double> eta_, u_, x_;  // x = ln(rho) of the bin centres
+  int J_ = 0;
+  double rho_min_ = 0, rho_max_ = 0;
+  std::uint64_t photons_ = 0;
+  // [slice][quantity][k * J + j]
+  std::vector<std::array<std::vector<double>, kTableQuantities>> f_;
+  std::vector<std::array<std::vector<float>, kTableQuantities>> rel_se_;
+  std::vector<std::vector<double>> log_total_;  // [slice][k]: log(total / alpha')
+};
+
+/// The tabulated model of one channel, in the shape of the other models: lengths in mm.
+template <typename T>
+class TabulatedModel {
+ public:
+  /// The profile's g is the medium's anisotropy (the medium's own g is not used: sigma_s' is).
+  TabulatedModel(const TabulatedProfile& profile, const Medium<T>& m)
+      : profile_(&profile), eta_(m.eta) {
+    sigma_t_reduced_ = m.sigma_a + m.sigma_s * (T(1) - m.g);
+    alpha_prime_ = sigma_t_reduced_ > T(0) ? m.sigma_s * (T(1) - m.g) / sigma_t_reduced_ : T(0);
+  }
+
+  /// Radial exitance R(r) per mm^2 per unit power entering.
+  T R_d(T r_mm) const { return at(TableQuantity::kExitance, r_mm); }
+  /// pi L(r) along the normal per mm^2 per unit power entering.
+  T radiance(T r_mm) const { return at(TableQuantity::kRadiance, r_mm); }
+  T at(TableQuantity q, T r_mm) const {
+    if (!(alpha_prime_ > T(0))) return T(0);
+    const T rho = r_mm * sigma_t_reduced_;
+    const T floor(1e-12);  // r = 0: the innermost bin's power law would diverge
+    return sigma_t_reduced_ * sigma_t_reduced_ *
+           profile_->value(q, rho > floor ? rho : floor, alpha_prime_, eta_);
+  }
+  T total_diffuse_reflectance() const {
+    if (!(alpha_prime_ > T(0))) return T(0);
+    return profile_->total(alpha_prime_, eta_);
+  }
+  const T& alpha_prime() const { return alpha_prime_; }
+  const T& sigma_t_reduced() const { return sigma_t_reduced_; }
+
+ private:
+  const TabulatedProfile* profile_;
+  T eta_, sigma_t_reduced_, alpha_prime_;
+};
+
+}  // namespace lucent::materials

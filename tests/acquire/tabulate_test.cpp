@@ -1,0 +1,159 @@
+// lucent tabulate (tabulate.h) and the shipped transport table against fresh runs of the capture
+// simulator (photon_transport.h), which is itself held against an independent Monte Carlo code.
+#include "lucent/acquire/tabulate.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <vector>
+
+#include "lucent/acquire/photon_transport.h"
+#include "lucent/materials/error.h"
+#include "lucent/materials/tabulated.h"
+#include "lucent/materials/transport_table.h"
+
+namespace lucent::acquire {
+namespace {
+
+using materials::TableQuantity;
+
+TabulateOptions tiny() {
+  TabulateOptions o;
+  o.eta = {1.3, 1.5};
+  o.grid.u = {0, 0.3, 0.7, 0.9};
+  o.grid.rho_min = 0.1;
+  o.grid.rho_max = 10;
+  o.grid.rho_per_decade = 5;
+  o.photons = 4000;
+  o.groups = 4;
+  o.max_path = 2000;
+  return o;
+}
+
+TEST(Tabulate, DeterministicWhateverTheThreadsAndTheSharding) {
+  TabulateOptions o = tiny();
+  o.threads = 1;
+  const materials::TransportTable one = tabulate_transport(o);
+  o.threads = 2;
+  const materials::TransportTable two = tabulate_transport(o);
+  std::vector<materials::TransportTable> shards;
+  for (int i = 0; i < 3; ++i) {
+    TabulateOptions s = o;
+    s.shard_index = i;
+    s.shard_count = 3;
+    shards.push_back(tabulate_transport(s));
+    EXPECT_TRUE(shards.back().partial);
+  }
+  const materials::TransportTable merged = materials::merge_transport_tables(shards);
+  ASSERT_EQ(one.slices.size(), 2u);
+  for (std::size_t s = 0; s < one.slices.size(); ++s) {
+    for (int q = 0; q < materials::kTableQuantities; ++q) {
+      EXPECT_EQ(one.slices[s].value[q], two.slices[s].value[q]);
+      EXPECT_EQ(one.slices[s].value[q], merged.slices[s].value[q]);
+      EXPECT_EQ(one.slices[s].se_code[q], merged.slices[s].se_code[q]);
+    }
+    EXPECT_EQ(one.slices[s].total, merged.slices[s].total);
+  }
+  // Missing a shard: refused, naming the gap.
+  shards.pop_back();
+  EXPECT_THROW(materials::merge_transport_tables(shards), Error);
+  // A different seed gives a different table.
+  o.seed = 2;
+  EXPECT_NE(tabulate_transport(o).slices[0].value[0], one.slices[0].value[0]);
+}
+
+TEST(Tabulate, RejectsBadOptions) {
+  TabulateOptions o = tiny();
+  o.eta = {1.5, 1.3};
+  EXPECT_THROW(tabulate_transport(o), Error);
+  o = tiny();
+  o.g = {0.99};
+  EXPECT_THROW(tabulate_transport(o), Error);
+  o = tiny();
+  o.shard_index = 3;
+  o.shard_count = 3;
+  EXPECT_THROW(tabulate_transport(o), Error);
+  o = tiny();
+  o.groups = 1;
+  EXPECT_THROW(tabulate_transport(o), Error);
+}
+
+struct Comparison {
+  int bins = 0, within = 0;  // bins with rho in [0.05, 50] and enough signal; within the bound
+  double worst_z = 0;        // largest |difference| / combined SE
+  double total_error = 0;    // relative, total diffuse reflectance
+  double total_z = 0;
+};
+
+// The shipped table's exitance against a direct simulation of (alpha', eta) at sigma_t' = 1,
+// averaged over the simulator's annuli (Gauss-Legendre in r^2).
+Comparison compare(double alpha, double eta, std::uint64_t photons) {
+  const materials::TabulatedProfile profile(materials::default_transport_table(), 0.0);
+  PhotonTransportOptions o;
+  o.media[0] = materials::Medium<double>{1 - alpha, alpha, 0.0, eta};
+  o.channels = {true, false, false};
+  o.photons = photons;
+  o.image = false;
+  o.seed = 7;
+  o.max_radius_mm = 60;
+  const PhotonTransportResult r = simulate_photon_transport(o);
+  const ChannelTransportResult& ch = r.channels[0];
+  const double entering = 1 - ch.specular_reflectance.value;
+  const materials::TabulatedModel<double> model(profile, o.media[0]);
+  constexpr double kNodes[4] = {0.0694318442, 0.3300094782, 0.6699905218, 0.9305681558};
+  constexpr double kWeights[4] = {0.1739274226, 0.3260725774, 0.3260725774, 0.1739274226};
+  Comparison c;
+  for (std::size_t i = 0; i < r.bins.size(); ++i) {
+    const double r0 = r.bins[i].r_inner_mm, r1 = r.bins[i].r_outer_mm;
+    if (r0 < 0.05 || r1 > 50) continue;
+    const double mc = ch.exitance[i].value / entering, se = ch.exitance[i].standard_error / entering;
+    if (!(mc > 5 * se)) continue;  // the noise, not the profile
+    double tab = 0;
+    for (int k = 0; k < 4; ++k)
+      tab += kWeights[k] * model.R_d(std::sqrt(r0 * r0 + kNodes[k] * (r1 * r1 - r0 * r0)));
+    const double tab_se = tab * profile.relative_se(TableQuantity::kExitance, r.bins[i].r_centre_mm,
+                                                    alpha, eta);
+    const double combined = std::hypot(se, std::isfinite(tab_se) ? tab_se : 0.0);
+    const double z = std::abs(tab - mc) / combined;
+    ++c.bins;
+    // The bound: within 1% or 2 standard errors.
+    if (std::abs(tab / mc - 1) <= 0.01 || z <= 2) ++c.within;
+    c.worst_z = std::max(c.worst_z, z);
+  }
+  const double total_mc = ch.diffuse_reflectance.value / entering;
+  const double total_se = ch.diffuse_reflectance.standard_error / entering;
+  const double total = model.total_diffuse_reflectance();
+  c.total_error = total / total_mc - 1;
+  c.total_z = std::abs(total - total_mc) / total_se;
+  return c;
+}
+
+// 20 (alpha', eta) points off the table's nodes, from nearly black to milk-white. A bin passes
+// at "within 1% or 2 standard errors" (the table's and the run's combined): with hundreds of bins
+// about 5% miss that by chance alone, so at least 90% must pass, and none may be beyond 4.5
+// standard errors (a real error, not noise). Totals: within 0.5% or 2.5 standard errors.
+TEST(ShippedTable, MatchesFreshSimulatorRunsOffTheGrid) {
+  const std::vector<std::pair<double, double>> points{
+      {0.012, 1.05}, {0.08, 1.45},  {0.2, 1.33},   {0.31, 1.17},  {0.45, 1.55},
+      {0.52, 1.02},  {0.63, 1.38},  {0.71, 1.26},  {0.78, 1.49},  {0.84, 1.12},
+      {0.88, 1.58},  {0.915, 1.34}, {0.94, 1.44},  {0.96, 1.08},  {0.975, 1.52},
+      {0.985, 1.23}, {0.992, 1.36}, {0.996, 1.47}, {0.9985, 1.15}, {0.9994, 1.33}};
+  int bins = 0, within = 0;
+  for (const auto& [alpha, eta] : points) {
+    // Cost per photon grows as 1 / (1 - alpha'): fewer photons for the white ones.
+    const std::uint64_t photons = alpha > 0.99 ? 12000 : alpha > 0.9 ? 30000 : 60000;
+    const Comparison c = compare(alpha, eta, photons);
+    bins += c.bins;
+    within += c.within;
+    EXPECT_LT(c.worst_z, 4.5) << "alpha' " << alpha << " eta " << eta;
+    EXPECT_TRUE(std::abs(c.total_error) < 0.005 || c.total_z < 2.5)
+        << "alpha' " << alpha << " eta " << eta << ": total off by " << c.total_error << " ("
+        << c.total_z << " SE)";
+    EXPECT_GT(c.bins, 10) << "alpha' " << alpha;
+  }
+  EXPECT_GE(within, 0.9 * bins) << within << " of " << bins << " bins within 1% or 2 SE";
+}
+
+}  // namespace
+}  // namespace lucent::acquire

@@ -1,0 +1,209 @@
+// The transport table's file and the tabulated model's interpolation (tabulated.h,
+// transport_table.h). The table against Monte Carlo lives in tests/acquire/tabulate_test.cpp.
+#include "lucent/materials/tabulated.h"
+
+#include <gtest/gtest.h>
+
+#include <ceres/jet.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "lucent/materials/error.h"
+#include "lucent/materials/transport_table.h"
+
+namespace lucent::materials {
+namespace {
+
+namespace fs = std::filesystem;
+
+double interpolate(const std::vector<double>& x, const std::vector<double>& f, double t,
+                   bool extrapolate = true) {
+  const NodeWeights<double> w = hermite_weights(x, t, extrapolate);
+  double sum = 0;
+  for (int i = 0; i < w.count; ++i) sum += w.w[std::size_t(i)] * f[std::size_t(w.first + i)];
+  return sum;
+}
+
+TEST(HermiteWeights, ReproduceQuadraticsOnNonuniformNodesAndSumToOne) {
+  // The distance-weighted three-point tangent is exact for quadratics, so the cubic Hermite
+  // interpolant reproduces them in every interior cell.
+  const std::vector<double> x{0, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.4, 0.7, 1.0};
+  std::vector<double> f;
+  for (double v : x) f.push_back(3 - 2 * v + 5 * v * v);
+  for (double t = 0.0051; t < 0.69; t *= 1.07) {
+    EXPECT_NEAR(interpolate(x, f, t), 3 - 2 * t + 5 * t * t, 1e-12) << t;
+    const NodeWeights<double> w = hermite_weights(x, t, true);
+    double sum = 0;
+    for (int i = 0; i < w.count; ++i) sum += w.w[std::size_t(i)];
+    EXPECT_NEAR(sum, 1.0, 1e-12);
+  }
+  // Nodes are hit exactly; outside, linear extrapolation or the end value.
+  for (std::size_t i = 0; i < x.size(); ++i) EXPECT_NEAR(interpolate(x, f, x[i]), f[i], 1e-12);
+  EXPECT_NEAR(interpolate(x, f, 1.3, false), f.back(), 1e-12);
+  EXPECT_NEAR(interpolate(x, f, -0.01), f[0] - 0.01 * (f[1] - f[0]) / 0.005, 1e-12);
+}
+
+TEST(HermiteWeights, FirstDerivativeIsContinuousAcrossNodes) {
+  // C1: the derivative from either side of a node agrees (Ceres sees no kinks).
+  const std::vector<double> x{0, 0.1, 0.25, 0.3, 0.6, 1.0};
+  const std::vector<double> f{1.0, -0.4, 2.0, 0.3, 0.9, -1.2};
+  for (std::size_t i = 1; i + 1 < x.size(); ++i) {
+    using J = ceres::Jet<double, 1>;
+    const auto derivative = [&](double t) {
+      const NodeWeights<J> w = hermite_weights(x, J(t, 0), true);
+      J sum(0);
+      for (int k = 0; k < w.count; ++k) sum += w.w[std::size_t(k)] * f[std::size_t(w.first + k)];
+      return sum.v[0];
+    };
+    EXPECT_NEAR(derivative(x[i] - 1e-9), derivative(x[i] + 1e-9), 1e-5) << "node " << i;
+    EXPECT_NE(derivative(x[i] - 1e-9), 0.0);
+  }
+}
+
+TEST(RelativeSeCode, RoundTripsWithinItsStepAndMarksExtrapolation) {
+  for (double rel : {1e-5, 3e-4, 0.01, 0.2, 5.0}) {
+    const double back = decode_relative_se(encode_relative_se(rel, false));
+    EXPECT_NEAR(std::log(back / rel), 0.0, std::log(10.0) / 80 + 1e-12) << rel;
+  }
+  EXPECT_EQ(encode_relative_se(0.01, true), kExtrapolatedEntry);
+  EXPECT_TRUE(std::isinf(decode_relative_se(kExtrapolatedEntry)));
+}
+
+// A small synthetic finished table: value(rho, u) = e^(-2 u rho) / (rho + 0.1), so that the
+// interpolant can be checked against the formula it was sampled from.
+TransportTable synthetic_table() {
+  TransportTable t;
+  t.grid.u = {0, 0.1, 0.2, 0.4, 0.6, 0.8, 0.95};
+  t.grid.rho_min = 0.01;
+  t.grid.rho_max = 100;
+  t.grid.rho_per_decade = 20;
+  t.groups = 4;
+  const int J = t.grid.rho_bins();
+  for (double eta : {1.0, 1.3, 1.6}) {
+    TransportTableSlice s;
+    s.eta = eta;
+    s.photons = 1000;
+    for (int q = 0; q < kTableQuantities; ++q) {
+      for (std::size_t k = 0; k < t.grid.u.size(); ++k) {
+        for (int j = 0; j < J; ++j) {
+          // Bin averages over the annulus (fine midpoint rule in r^2).
+          const double r0 = t.grid.rho_edge(j), r1 = t.grid.rho_edge(j + 1);
+          double avg = 0;
+          for (int m = 0; m < 200; ++m) {
+            const double r = std::sqrt(r0 * r0 + (m + 0.5) / 200 * (r1 * r1 - r0 * r0));
+            avg += std::exp(-2 * t.grid.u[k] * r) / (r + 0.1) * (q + 1) * eta / 200;
+          }
+          s.value[std::size_t(q)].push_back(float(avg));
+          s.se_code[std::size_t(q)].push_back(encode_relative_se(0.01, false));
+        }
+      }
+    }
+    for (double u : t.grid.u) s.total.push_back(0.5 * (1 - u * u)), s.total_se.push_back(1e-4);
+    t.slices.push_back(s);
+    t.slice_axes.push_back({eta, 0.0, 1000.0});
+  }
+  return t;
+}
+
+TEST(TabulatedProfile, InterpolatesBinAveragesBackToPointValues) {
+  const TabulatedProfile p(synthetic_table(), 0.0);
+  double worst = 0;
+  for (double rho = 0.05; rho < 50; rho *= 1.13) {
+    for (double u : {0.05, 0.3, 0.5, 0.7}) {
+      const double a = 1 - u * u;
+      const double exact = std::exp(-2 * u * rho) / (rho + 0.1) * 1.3;
+      const double v = p.value(TableQuantity::kExitance, rho, a, 1.3);
+      // Far out, log value falls by ~2 u rho: relative error stays small only up to the curvature
+      // the u grid resolves; judge the near and middle field where it matters.
+      if (2 * u * rho < 20) worst = std::max(worst, std::abs(v / exact - 1));
+    }
+  }
+  EXPECT_LT(worst, 0.01) << "the synthetic profile is smooth: interpolation within 1%";
+  // The radiance quantity is kept apart (twice the exitance in this table).
+  EXPECT_NEAR(p.value(TableQuantity::kRadiance, 1.0, 0.91, 1.3) /
+                  p.value(TableQuantity::kExitance, 1.0, 0.91, 1.3),
+              2.0, 1e-6);
+  // Between eta slices: linear in eta in this table, reproduced to 1e-3.
+  EXPECT_NEAR(p.value(TableQuantity::kExitance, 1.0, 0.91, 1.45) /
+                  p.value(TableQuantity::kExitance, 1.0, 0.91, 1.3),
+              1.45 / 1.3, 1e-3);
+}
+
+TEST(TabulatedProfile, FiniteAtTheExtremes) {
+  const TabulatedProfile p(synthetic_table(), 0.0);
+  for (double a : {1e-6, 1e-3, 0.5, 1 - 1e-8, 1.0}) {
+    for (double rho : {0.0, 1e-9, 1e-3, 1.0, 1e3, 1e5}) {
+      for (double eta : {0.9, 1.0, 1.33, 1.6, 2.5}) {
+        const double v = p.value(TableQuantity::kExitance, std::max(rho, 1e-12), a, eta);
+        EXPECT_TRUE(std::isfinite(v) && v >= 0) << a << " " << rho << " " << eta;
+      }
+    }
+  }
+  const Medium<double> m{1e-9, 5.0, 0.0, 1.3};
+  const TabulatedModel<double> model(p, m);
+  EXPECT_TRUE(std::isfinite(model.R_d(0.0)));
+  EXPECT_TRUE(std::isfinite(model.total_diffuse_reflectance()));
+}
+
+TEST(TransportTableFile, RoundTripsAndRejectsDamage) {
+  const fs::path dir = fs::temp_directory_path() / ("lucent_table_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const TransportTable t = synthetic_table();
+  write_transport_table(t, dir / "t.lut");
+  const TransportTable back = read_transport_table(dir / "t.lut");
+  ASSERT_EQ(back.slices.size(), t.slices.size());
+  EXPECT_EQ(back.grid, t.grid);
+  EXPECT_EQ(back.slices[1].value[1], t.slices[1].value[1]);
+  EXPECT_EQ(back.slices[2].total, t.slices[2].total);
+
+  std::string bytes;
+  {
+    std::ifstream in(dir / "t.lut", std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const auto write = [&](const std::string& name, const std::string& content) {
+    std::ofstream(dir / name, std::ios::binary) << content;
+    return dir / name;
+  };
+  std::string flipped = bytes;
+  flipped[flipped.size() - 100] ^= 0x40;
+  EXPECT_THROW(
+      {
+        try {
+          read_transport_table(write("flipped.lut", flipped));
+        } catch (const Error& e) {
+          EXPECT_NE(std::string(e.what()).find("crc32"), std::string::npos) << e.what();
+          throw;
+        }
+      },
+      Error);
+  EXPECT_THROW(read_transport_table(write("short.lut", bytes.substr(0, bytes.size() - 7))), Error);
+  EXPECT_THROW(read_transport_table(write("text.lut", "{\"format\": \"lucent-material\"}\n")), Error);
+  EXPECT_THROW(read_transport_table(write("empty.lut", "")), Error);
+  EXPECT_THROW(read_transport_table(dir / "missing.lut"), Error);
+  fs::remove_all(dir);
+}
+
+TEST(TransportTableFile, MergeJoinsDisjointSlicesAndRefusesDuplicates) {
+  TransportTable a = synthetic_table(), b = synthetic_table();
+  a.slices.resize(1), a.slice_axes.resize(1);            // eta 1.0
+  b.slices.erase(b.slices.begin()), b.slice_axes.erase(b.slice_axes.begin());  // 1.3, 1.6
+  const TransportTable m = merge_transport_tables({b, a});
+  ASSERT_EQ(m.slices.size(), 3u);
+  EXPECT_EQ(m.slices[0].eta, 1.0);
+  EXPECT_EQ(m.slices[2].eta, 1.6);
+  EXPECT_THROW(merge_transport_tables({a, a}), Error);
+  TransportTable other_grid = b;
+  other_grid.grid.rho_per_decade = 10;
+  EXPECT_THROW(merge_transport_tables({a, other_grid}), Error);
+}
+
+TEST(TabulatedProfile, RefusesAGOutsideTheTable) {
+  EXPECT_THROW(TabulatedProfile(synthetic_table(), 0.5), Error);
+}
+
+}  // namespace
+}  // namespace lucent::materials
