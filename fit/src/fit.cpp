@@ -59,11 +59,29 @@ struct Observations {
 
 // Residuals (log model - log data) * value / se: the log-ratio in units of the relative standard
 // error. Parameters: {log sigma_a, log sigma_s'}, {log scale}, {eta}.
+// A smooth relative change of the model, e^(epsilon shape(log10 rho)): how the tabulated model's
+// own error (its measured accuracy against fresh Monte Carlo) moves the answer.
+struct ModelPerturbation {
+  double epsilon = 0;
+  int shape = 0;  // 1: tilt across log rho in [-2, 2]; 2: a bow over the same range
+  template <typename T>
+  T factor(const T& rho) const {
+    using std::exp;
+    using std::log10;
+    if (epsilon == 0) return T(1);
+    T x = log10(rho) / T(2);
+    if (x < T(-1)) x = T(-1);
+    if (x > T(1)) x = T(1);
+    return exp(T(epsilon) * (shape == 1 ? x : T(2) * x * x - T(1)));
+  }
+};
+
 struct ProfileResiduals {
   const Observations* obs;
   FitModel model;
   GaussLegendre gl;
   const materials::TabulatedProfile* table = nullptr;  // kTabulated only
+  ModelPerturbation perturbation{};
 
   template <typename T>
   bool operator()(const T* const ab, const T* const log_scale, const T* const eta,
@@ -84,7 +102,12 @@ struct ProfileResiduals {
                                       obs->radial ? obs->r[i] : 0.0, obs->radial ? obs->r0[i] : 0.0,
                                       obs->radial ? obs->r1[i] : 0.0, obs->x[i], obs->y[i],
                                       obs->pixel, gl);
-      residual[i] = (log_front + log(v + T(1e-300)) - obs->log_value[i]) * obs->inv_rel_se[i];
+      T scaled = v;
+      if (perturbation.epsilon != 0) {
+        const double r = obs->radial ? obs->r[i] : std::hypot(obs->x[i], obs->y[i]);
+        scaled *= perturbation.factor(T(r) * (medium.sigma_a + medium.sigma_s));
+      }
+      residual[i] = (log_front + log(scaled + T(1e-300)) - obs->log_value[i]) * obs->inv_rel_se[i];
     }
     return true;
   }
@@ -324,7 +347,8 @@ std::string describe_combination(const Eigen::VectorXd& v, const std::vector<std
 ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, FitModel model,
                const materials::TabulatedProfile* table, double eta0, bool relative,
                const std::array<double, 3>& exclude, const std::array<StartValues, 3>& start,
-               std::array<bool, 3> channels, int* below_noise) {
+               std::array<bool, 3> channels, int* below_noise,
+               ModelPerturbation perturbation = {}) {
   const QualitySettings q = quality_settings(options.quality);
   const GaussLegendre gl = detail::gauss_legendre(q.footprint_order);
   Problem p;
@@ -384,12 +408,12 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
         block_channels.emplace_back(c, int(o.log_value.size()));
       } else if (options.loss == LossKind::kNone && !options.fit_ior && !scale_free) {
         auto* cost = new ceres::AutoDiffCostFunction<ChannelResiduals, ceres::DYNAMIC, 2>(
-            new ChannelResiduals{{&o, model, gl, table}, scale, &p.eta}, int(o.log_value.size()));
+            new ChannelResiduals{{&o, model, gl, table, perturbation}, scale, &p.eta}, int(o.log_value.size()));
         problem.AddResidualBlock(cost, nullptr, p.ab[c].data());
         block_channels.emplace_back(c, int(o.log_value.size()));
       } else if (options.loss == LossKind::kNone) {
         auto* cost = new ceres::AutoDiffCostFunction<ProfileResiduals, ceres::DYNAMIC, 2, 1, 1>(
-            new ProfileResiduals{&o, model, gl, table}, int(o.log_value.size()));
+            new ProfileResiduals{&o, model, gl, table, perturbation}, int(o.log_value.size()));
         problem.AddResidualBlock(cost, nullptr, p.ab[c].data(), scale, &p.eta);
         block_channels.emplace_back(c, int(o.log_value.size()));
       } else {
@@ -409,7 +433,7 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
           pick(one.inv_rel_se);
           pick(one.data_rel_se);
           auto* cost = new ceres::AutoDiffCostFunction<ProfileResiduals, ceres::DYNAMIC, 2, 1, 1>(
-              new ProfileResiduals{&one, model, gl, table}, 1);
+              new ProfileResiduals{&one, model, gl, table, perturbation}, 1);
           ceres::LossFunction* loss =
               options.loss == LossKind::kHuber
                   ? static_cast<ceres::LossFunction*>(new ceres::HuberLoss(options.loss_scale))
@@ -636,13 +660,13 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
   for (const ProfileData& d : data) {
     if (d.incidence_polar_deg > 0.5 || (!d.exitance && d.view_deg > 0.5)) radial_normal = false;
   }
-  std::shared_ptr<materials::TabulatedProfile> full, fixed;
+  std::shared_ptr<const materials::TabulatedProfile> full, fixed;
   std::string table_problem;
   if (radial_normal) {
     try {
       const materials::TransportTable& file =
           options.table ? *options.table : materials::default_transport_table();
-      full = std::make_shared<materials::TabulatedProfile>(file, options.g);
+      full = materials::cached_tabulated_profile(file, options.g);
       if (!options.fit_ior) {
         if (eta0 < full->eta_min() - 1e-9 || eta0 > full->eta_max() + 1e-9) {
           std::ostringstream m;
@@ -651,7 +675,7 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
             << " (build a wider table with lucent tabulate)";
           table_problem = m.str();
         } else {
-          fixed = std::make_shared<materials::TabulatedProfile>(full->at_eta(eta0));
+          fixed = materials::cached_tabulated_profile(file, options.g, eta0);
         }
       }
     } catch (const Error& e) {
@@ -720,7 +744,11 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
     return st;
   };
 
-  if (tab_ok && options.model != FitModel::kDirectionalDipole) {
+  if (tab_ok && !options.systematics) {
+    // The one model asked for and nothing else (timing); a tabulated fit starts from the data.
+    const FitModel m = options.model == FitModel::kAuto ? FitModel::kTabulated : options.model;
+    result.candidates.push_back(fit_model(m, start));
+  } else if (tab_ok && options.model != FitModel::kDirectionalDipole) {
     // The accurate model, started from the standard dipole's solution (cheap, and in the valley).
     const ModelFit dipole = fit_model(FitModel::kDipole, start);
     ModelFit accurate = fit_model(FitModel::kTabulated, started_from(dipole));
@@ -781,17 +809,64 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
     result.notes.push_back("no model exact to transport for these data (" + table_problem +
                            "): the diffusion model's own error is not in the uncertainty");
   }
+  if (tab_ok && options.systematics && result.chosen.model == FitModel::kTabulated) {
+    // The tabulated model's own error, two parts in quadrature. (1) The table's Monte Carlo noise,
+    // propagated by a parametric bootstrap: refits against realisations of the table drawn
+    // within its stated per-entry standard errors (common to every bin, so the weights alone
+    // cannot carry it). (2) Its accuracy as measured against fresh Monte Carlo runs
+    // (tests/acquire/tabulate_test.cpp: profiles within kTableAccuracy), as the shift of the
+    // answer under a smooth relative change of the model of that size, tilted or bowed across
+    // log rho.
+    constexpr int kBootstrap = 8;
+    constexpr double kTableAccuracy = 0.01;
+    const std::array<StartValues, 3> st = started_from(result.chosen);
+    const std::array<double, 3> ex = exclusion(FitModel::kTabulated, st);
+    std::array<std::array<double, 4>, 3> moments{};  // sum a, sum a^2, sum s, sum s^2
+    std::array<std::array<double, 2>, 3> shift2{};   // squared shifts under the model changes
+    int ignored = 0;
+    for (int b = 0; b < kBootstrap; ++b) {
+      const materials::TabulatedProfile shaken = tab->perturbed(1000 + std::uint64_t(b));
+      const ModelFit f = solve(data, options, FitModel::kTabulated, &shaken, result.chosen.eta,
+                               relative, ex, st, channels, &ignored);
+      for (int c = 0; c < 3; ++c) {
+        const double a = f.channels[c].sigma_a, s = f.channels[c].sigma_s_reduced;
+        moments[c][0] += a, moments[c][1] += a * a, moments[c][2] += s, moments[c][3] += s * s;
+      }
+    }
+    for (int shape : {1, 2}) {
+      const ModelFit f = solve(data, options, FitModel::kTabulated, tab, result.chosen.eta,
+                               relative, ex, st, channels, &ignored,
+                               ModelPerturbation{kTableAccuracy, shape});
+      for (int c = 0; c < 3; ++c) {
+        shift2[c][0] += std::pow(f.channels[c].sigma_a - result.chosen.channels[c].sigma_a, 2);
+        shift2[c][1] +=
+            std::pow(f.channels[c].sigma_s_reduced - result.chosen.channels[c].sigma_s_reduced, 2);
+      }
+    }
+    const auto var = [&](double sum, double sum2) {
+      return std::max(0.0, (sum2 - sum * sum / kBootstrap) / (kBootstrap - 1));
+    };
+    for (ModelFit* f : {&result.chosen, &result.candidates.front()}) {
+      for (int c = 0; c < 3; ++c) {
+        if (!channels[c]) continue;
+        f->channels[c].sd_sys_sigma_a = std::sqrt(var(moments[c][0], moments[c][1]) + shift2[c][0]);
+        f->channels[c].sd_sys_sigma_s_reduced =
+            std::sqrt(var(moments[c][2], moments[c][3]) + shift2[c][1]);
+      }
+    }
+  }
   detail::finish_uncertainty(result, data, options, channels);
-  if (tab_ok && result.chosen.model == FitModel::kTabulated) {
+  if (tab_ok && options.systematics && result.chosen.model == FitModel::kTabulated) {
     detail::judge_adequacy(result, data, channels);
     // g: radial data cannot tell it from sigma_s; say how far the answer moves at the other end.
     const double g_other = options.g < 0.45 ? 0.9 : 0.0;
     try {
       const materials::TransportTable& file =
           options.table ? *options.table : materials::default_transport_table();
-      const materials::TabulatedProfile other_full(file, g_other);
-      const materials::TabulatedProfile other =
-          options.fit_ior ? other_full : other_full.at_eta(result.chosen.eta);
+      const auto other_profile = materials::cached_tabulated_profile(
+          file, g_other,
+          options.fit_ior ? std::nullopt : std::optional<double>(result.chosen.eta));
+      const materials::TabulatedProfile& other = *other_profile;
       const std::array<StartValues, 3> st = started_from(result.chosen);
       int ignored = 0;
       const ModelFit shifted = solve(data, options, FitModel::kTabulated, &other,

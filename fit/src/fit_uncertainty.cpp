@@ -43,6 +43,7 @@ void finish_uncertainty(FitResult& result, const std::vector<ProfileData>& data,
   const auto finish = [&](ModelFit& f) {
     for (int c = 0; c < 3; ++c) {
       ChannelFit& ch = f.channels[c];
+      // The tabulated fit's systematic (its table's Monte Carlo error) was set by the bootstrap.
       if (accurate && f.model != FitModel::kTabulated) {
         ch.sd_sys_sigma_a = std::abs(ch.sigma_a - reference.channels[c].sigma_a);
         ch.sd_sys_sigma_s_reduced =

@@ -86,14 +86,9 @@ std::string to_string(DiffusionModel model) {
                                                        : "tabulated";
 }
 
+// One prepared profile per g (materials with sigma_s and g carry their own per channel).
 const TabulatedProfile& tabulated_profile_for(double g) {
-  // One prepared profile per g (materials with sigma_s and g carry their own per channel).
-  static std::mutex mutex;
-  static std::map<double, std::unique_ptr<TabulatedProfile>> cache;
-  std::lock_guard lock(mutex);
-  auto& slot = cache[g];
-  if (!slot) slot = std::make_unique<TabulatedProfile>(default_transport_table(), g);
-  return *slot;
+  return *cached_tabulated_profile(default_transport_table(), g);
 }
 
 std::vector<double> parse_radius_list(const std::string& text, const std::string& option) {

@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <mutex>
+#include <tuple>
+#include <random>
 #include <sstream>
 
 #include "lucent/materials/error.h"
@@ -11,19 +14,51 @@
 namespace lucent::materials {
 namespace {
 
-// Annulus average -> point value at the bin's log centre. With x = ln(rho), f = ln(value) and the
-// area element rho^2 dx, the average over a bin of width h is, to second order,
-//   ln(avg) = f + ((f' + 2)^2 + f'' - 4) h^2 / 24,
-// so f is ln(avg) less that term, with f', f'' from central differences of ln(avg) (the term is
-// 1e-3 of f in the steep near field: small, but it is bias, and removing it is free).
-void to_point_values(std::vector<double>& f, int J, double h) {
-  std::vector<double> out = f;
-  for (int j = 1; j + 1 < J; ++j) {
-    const double d1 = (f[std::size_t(j + 1)] - f[std::size_t(j - 1)]) / (2 * h);
-    const double d2 = (f[std::size_t(j + 1)] - 2 * f[std::size_t(j)] + f[std::size_t(j - 1)]) / (h * h);
-    out[std::size_t(j)] = f[std::size_t(j)] - ((d1 + 2) * (d1 + 2) + d2 - 4) * h * h / 24;
+// The row interpolant of log values p at x (ln rho), as TabulatedProfile::log_value has it:
+// Hermite inside, linear in x below the first centre, linear in rho beyond the last.
+double row_value(const std::vector<double>& x, const std::vector<double>& p, double lx) {
+  const std::size_t J = x.size();
+  if (lx > x.back()) {
+    const double slope = std::min(0.0, (p[J - 1] - p[J - 2]) / (x[J - 1] - x[J - 2]));
+    return p[J - 1] + slope * (std::exp(lx - x.back()) - 1);
   }
-  f = out;
+  const NodeWeights<double> w = hermite_weights(x, lx, true);
+  double sum = 0;
+  for (int k = 0; k < w.count; ++k) sum += w.w[std::size_t(k)] * p[std::size_t(w.first + k)];
+  return sum;
+}
+
+// Annulus averages -> point values at the bins' log centres. The file holds what Monte Carlo
+// measures, the mean over each annulus; the interpolant needs point values, and in a steep far
+// field (log value falling by ~sigma_tr rho, tens across a decade) the two differ by far more than
+// a second-order correction can mend. So the point values p are found by fixed-point iteration:
+// p += ln(stored average) - ln(average of the interpolant of p over the annulus), the average by
+// 8-point Gauss-Legendre in r^2 (uniform in area). Four rounds bring the interpolant's averages
+// to the stored ones within 1e-4 relative.
+void to_point_values(std::vector<double>& f, const std::vector<double>& x,
+                     const TransportTableGrid& grid) {
+  static constexpr double kNode[8] = {0.0198550718, 0.1016667613, 0.2372337950, 0.4082826788,
+                                      0.5917173212, 0.7627662050, 0.8983332387, 0.9801449282};
+  static constexpr double kWeight[8] = {0.0506142681, 0.1111905172, 0.1568533229, 0.1813418917,
+                                        0.1813418917, 0.1568533229, 0.1111905172, 0.0506142681};
+  const int J = int(x.size());
+  std::vector<double> p = f;
+  for (int round = 0; round < 4; ++round) {
+    std::vector<double> next = p;
+    for (int j = 0; j < J; ++j) {
+      const double r0 = grid.rho_edge(j), r1 = grid.rho_edge(j + 1);
+      double avg = 0;
+      for (int k = 0; k < 8; ++k) {
+        const double r = std::sqrt(r0 * r0 + kNode[k] * (r1 * r1 - r0 * r0));
+        avg += kWeight[k] * std::exp(row_value(x, p, std::log(r)) - f[std::size_t(j)]);
+      }
+      // Guard: an average that over- or underflows (a row that runs into the 1e-37 floor of the
+      // file) leaves the value as it is.
+      if (std::isfinite(avg) && avg > 0) next[std::size_t(j)] = p[std::size_t(j)] - std::log(avg);
+    }
+    p = next;
+  }
+  f = p;
 }
 
 }  // namespace
@@ -54,7 +89,6 @@ TabulatedProfile::TabulatedProfile(const TransportTable& table, double g) : g_(g
   J_ = table.grid.rho_bins();
   rho_min_ = table.grid.rho_min;
   rho_max_ = table.grid.rho_max;
-  const double h = std::log(10.0) / table.grid.rho_per_decade;
   for (int j = 0; j < J_; ++j) x_.push_back(std::log(table.grid.rho_centre(j)));
 
   // g weights (double): a node, or the Hermite interpolant between nodes.
@@ -64,7 +98,7 @@ TabulatedProfile::TabulatedProfile(const TransportTable& table, double g) : g_(g
   for (std::size_t e = 0; e < eta_.size(); ++e) {
     std::array<std::vector<double>, kTableQuantities> f;
     std::array<std::vector<float>, kTableQuantities> se;
-    std::vector<double> lt(K, 0.0);
+    std::vector<double> lt(K, 0.0), tse(K, 0.0);
     for (int q = 0; q < kTableQuantities; ++q) {
       f[std::size_t(q)].assign(n, 0.0);
       se[std::size_t(q)].assign(n, 0.0f);
@@ -79,8 +113,10 @@ TabulatedProfile::TabulatedProfile(const TransportTable& table, double g) : g_(g
           const double a = 1 - u_[k] * u_[k];
           std::vector<double> row(static_cast<std::size_t>(J_));
           for (int j = 0; j < J_; ++j)
-            row[std::size_t(j)] = std::log(double(s.value[std::size_t(q)][k * std::size_t(J_) + std::size_t(j)]) / a);
-          to_point_values(row, J_, h);
+            row[std::size_t(j)] = std::log(
+                std::max(double(s.value[std::size_t(q)][k * std::size_t(J_) + std::size_t(j)]),
+                         1e-37) / a);
+          to_point_values(row, x_, table.grid);
           for (int j = 0; j < J_; ++j) {
             const std::size_t i = k * std::size_t(J_) + std::size_t(j);
             f[std::size_t(q)][i] += w * row[std::size_t(j)];
@@ -92,11 +128,13 @@ TabulatedProfile::TabulatedProfile(const TransportTable& table, double g) : g_(g
       for (std::size_t k = 0; k < K; ++k) {
         const double a = 1 - u_[k] * u_[k];
         lt[k] += w * std::log(std::max(s.total[k], 1e-300) / a);
+        tse[k] = std::max(tse[k], s.total[k] > 0 ? s.total_se[k] / s.total[k] : INFINITY);
       }
     }
     f_.push_back(std::move(f));
     rel_se_.push_back(std::move(se));
     log_total_.push_back(std::move(lt));
+    total_rel_se_.push_back(std::move(tse));
   }
 }
 
@@ -132,6 +170,29 @@ TabulatedProfile TabulatedProfile::at_eta(double eta) const {
   p.f_ = {std::move(f)};
   p.rel_se_ = {std::move(se)};
   p.log_total_ = {std::move(lt)};
+  std::vector<double> tse(u_.size(), 0.0);
+  for (int a = 0; a < we.count; ++a)
+    if (we.w[std::size_t(a)] != 0)
+      for (std::size_t k = 0; k < tse.size(); ++k)
+        tse[k] = std::max(tse[k], total_rel_se_[std::size_t(we.first + a)][k]);
+  p.total_rel_se_ = {std::move(tse)};
+  return p;
+}
+
+TabulatedProfile TabulatedProfile::perturbed(std::uint64_t seed) const {
+  TabulatedProfile p = *this;
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (std::size_t s = 0; s < p.f_.size(); ++s) {
+    for (int q = 0; q < kTableQuantities; ++q) {
+      std::vector<double>& f = p.f_[s][std::size_t(q)];
+      const std::vector<float>& se = p.rel_se_[s][std::size_t(q)];
+      for (std::size_t i = 0; i < f.size(); ++i) {
+        const double draw = normal(rng);  // drawn for every entry: the stream does not depend on
+        if (std::isfinite(se[i])) f[i] += draw * std::min(double(se[i]), 1.0);  // which are finite
+      }
+    }
+  }
   return p;
 }
 
@@ -153,6 +214,32 @@ double TabulatedProfile::relative_se(TableQuantity q, double rho, double alpha_p
     worst = std::max(worst, double(rel_se_[s][std::size_t(q)][(k + 1) * std::size_t(J_) + j]));
   if (rho > std::exp(x_.back())) worst = INFINITY;  // beyond the table: an extrapolation
   return worst;
+}
+
+std::shared_ptr<const TabulatedProfile> cached_tabulated_profile(const TransportTable& table,
+                                                                 double g,
+                                                                 std::optional<double> eta) {
+  using Key = std::tuple<const TransportTable*, double, bool, double>;
+  static std::mutex mutex;
+  static std::map<Key, std::shared_ptr<const TabulatedProfile>> cache;
+  const Key full_key{&table, g, false, 0.0};
+  std::lock_guard lock(mutex);
+  auto& full = cache[full_key];
+  if (!full) full = std::make_shared<const TabulatedProfile>(table, g);
+  if (!eta) return full;
+  auto& fixed = cache[Key{&table, g, true, *eta}];
+  if (!fixed) fixed = std::make_shared<const TabulatedProfile>(full->at_eta(*eta));
+  return fixed;
+}
+
+double TabulatedProfile::total_relative_se(double alpha_prime, double eta) const {
+  const double u = std::sqrt(std::max(0.0, 1 - alpha_prime));
+  const std::size_t s = std::size_t(std::min_element(eta_.begin(), eta_.end(), [&](double a, double b) {
+                                      return std::abs(a - eta) < std::abs(b - eta);
+                                    }) - eta_.begin());
+  const std::size_t k = std::min<std::size_t>(
+      u_.size() - 1, std::size_t(std::upper_bound(u_.begin(), u_.end(), u) - u_.begin()));
+  return std::max(total_rel_se_[s][k], total_rel_se_[s][k > 0 ? k - 1 : 0]);
 }
 
 std::string TabulatedProfile::to_string() const {

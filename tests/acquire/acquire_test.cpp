@@ -296,7 +296,9 @@ TEST(HdrMerge, PixelsBlackInEveryBracketAreMasked) {
 TEST(HdrMerge, DarkFrameIsSubtractedBeforeDividingByExposure) {
   const fs::path dir = scratch_dir("merge-dark");
   ImageRgb truth = spot_radiance(Spot{});
-  truth.at(0, 0, 0) = truth.at(0, 0, 1) = truth.at(0, 0, 2) = 0.0f;  // at the dark level: black
+  // At the dark level: a measurement of no light (valid, ~0), not censored. Masking such pixels
+  // kept only those that noise lifted above the dark level: a floor in faint profiles.
+  truth.at(0, 0, 0) = truth.at(0, 0, 1) = truth.at(0, 0, 2) = 0.0f;
   StackSpec spec;
   spec.dark_offset = 0.01;  // a black level of 1% of the range in every bracket
   const ImageSet set = write_brackets(dir, "b", truth, spec);
@@ -304,8 +306,9 @@ TEST(HdrMerge, DarkFrameIsSubtractedBeforeDividingByExposure) {
                                              Response::kLinear, spec.dark_offset));
   const HdrResult with_dark = merge_brackets(set, Response::kLinear, fs::path("dark.png"), dir);
   const HdrResult without = merge_brackets(set, Response::kLinear, std::nullopt, dir);
-  EXPECT_EQ(with_dark.mask_at(0, 0, 1), PixelMask::kBlack);
-  EXPECT_EQ(with_dark.counts.black[1], 1);
+  EXPECT_EQ(with_dark.mask_at(0, 0, 1), PixelMask::kValid);
+  EXPECT_EQ(with_dark.counts.black[1], 0);
+  EXPECT_NEAR(with_dark.radiance.at(0, 0, 1), 0.0, 1e-6);
   for (std::size_t i = 3; i < truth.data.size(); ++i) {
     if (with_dark.mask[i] != PixelMask::kValid) continue;
     EXPECT_NEAR(with_dark.radiance.data[i], spec.gain * truth.data[i],

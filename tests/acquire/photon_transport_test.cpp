@@ -446,11 +446,11 @@ TEST(PhotonTransport, ExitanceCsvCarriesTotalsAndOneRowPerBin) {
   std::string line;
   std::vector<std::string> comments;
   while (std::getline(in, line) && line.starts_with("#")) comments.push_back(line);
-  EXPECT_EQ(line, "r_mm,R_r,R_g,R_b,se_r,se_g,se_b");
+  EXPECT_EQ(line, "r_mm,R_r,R_g,R_b,se_r,se_g,se_b,r_inner_mm,r_outer_mm");
   std::size_t rows = 0;
   while (std::getline(in, line)) {
     ++rows;
-    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 6);
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 8);
   }
   EXPECT_EQ(rows, result.bins.size());
   auto has = [&](const std::string& token) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <vector>
 
@@ -81,6 +82,7 @@ TEST(Tabulate, RejectsBadOptions) {
 
 struct Comparison {
   int bins = 0, within = 0;  // bins with rho in [0.05, 50] and enough signal; within the bound
+  int extrapolated = 0;      // bins where the table extrapolates (not judged)
   double worst_z = 0;        // largest |difference| / combined SE
   double total_error = 0;    // relative, total diffuse reflectance
   double total_z = 0;
@@ -114,18 +116,28 @@ Comparison compare(double alpha, double eta, std::uint64_t photons) {
       tab += kWeights[k] * model.R_d(std::sqrt(r0 * r0 + kNodes[k] * (r1 * r1 - r0 * r0)));
     const double tab_se = tab * profile.relative_se(TableQuantity::kExitance, r.bins[i].r_centre_mm,
                                                     alpha, eta);
-    const double combined = std::hypot(se, std::isfinite(tab_se) ? tab_se : 0.0);
+    // Where the table's own entries are far-tail extrapolations (no photon of the build got
+    // there: the near-black albedos far out) it claims nothing, and the fit gives those radii no
+    // weight; they are counted, not judged.
+    if (!std::isfinite(tab_se)) {
+      ++c.extrapolated;
+      continue;
+    }
+    const double combined = std::hypot(se, tab_se);
     const double z = std::abs(tab - mc) / combined;
     ++c.bins;
     // The bound: within 1% or 2 standard errors.
     if (std::abs(tab / mc - 1) <= 0.01 || z <= 2) ++c.within;
     c.worst_z = std::max(c.worst_z, z);
+    if (z > 4 && std::getenv("LUCENT_TABLE_TEST_VERBOSE"))
+      std::printf("  r %.4f..%.4f mc %.4e +- %.1e tab %.4e +- %.1e\n", r0, r1, mc, se, tab, tab_se);
   }
   const double total_mc = ch.diffuse_reflectance.value / entering;
   const double total_se = ch.diffuse_reflectance.standard_error / entering;
   const double total = model.total_diffuse_reflectance();
   c.total_error = total / total_mc - 1;
-  c.total_z = std::abs(total - total_mc) / total_se;
+  c.total_z = std::abs(total - total_mc) /
+              std::hypot(total_se, total * profile.total_relative_se(alpha, eta));
   return c;
 }
 
@@ -141,12 +153,20 @@ TEST(ShippedTable, MatchesFreshSimulatorRunsOffTheGrid) {
       {0.985, 1.23}, {0.992, 1.36}, {0.996, 1.47}, {0.9985, 1.15}, {0.9994, 1.33}};
   int bins = 0, within = 0;
   for (const auto& [alpha, eta] : points) {
-    // Cost per photon grows as 1 / (1 - alpha'): fewer photons for the white ones.
-    const std::uint64_t photons = alpha > 0.99 ? 12000 : alpha > 0.9 ? 30000 : 60000;
+    // Cost per photon grows as 1 / (1 - alpha'): fewer photons for the white ones, many for the
+    // near-black ones, whose far bins otherwise hold a handful of photons and a skewed mean.
+    const std::uint64_t photons = alpha > 0.99  ? 12000
+                                  : alpha > 0.9 ? 30000
+                                  : alpha > 0.5 ? 100000
+                                                : 600000;
     const Comparison c = compare(alpha, eta, photons);
     bins += c.bins;
     within += c.within;
     EXPECT_LT(c.worst_z, 4.5) << "alpha' " << alpha << " eta " << eta;
+    std::printf("alpha' %.4f eta %.2f: %d bins, %d within 1%% or 2 SE, worst %.2f SE, %d "
+                "extrapolated; total %+.3f%% (%.2f SE)\n",
+                alpha, eta, c.bins, c.within, c.worst_z, c.extrapolated, 100 * c.total_error,
+                c.total_z);
     EXPECT_TRUE(std::abs(c.total_error) < 0.005 || c.total_z < 2.5)
         << "alpha' " << alpha << " eta " << eta << ": total off by " << c.total_error << " ("
         << c.total_z << " SE)";

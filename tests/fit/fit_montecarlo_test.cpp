@@ -20,7 +20,7 @@ TEST(FitMonteCarlo, DefaultFitOfSimulatedExitanceRecoversTheTruthWithinItsTotalU
   const materials::Material m = materials::load_material("skin1");
   acquire::PhotonTransportOptions o;
   for (int c = 0; c < 3; ++c) o.media[std::size_t(c)] = m.medium(c);
-  o.photons = 300000;
+  o.photons = 1000000;  // the truth: >= 1e6 photons per channel (about 4 s here)
   o.image = false;
   o.max_radius_mm = 40;
   o.seed = 11;
@@ -39,11 +39,12 @@ TEST(FitMonteCarlo, DefaultFitOfSimulatedExitanceRecoversTheTruthWithinItsTotalU
     for (auto [value, sd, truth] : {std::tuple{ch.sigma_a, ch.sd_sigma_a, m.sigma_a[c]},
                                     std::tuple{ch.sigma_s_reduced, ch.sd_sigma_s_reduced,
                                                m.sigma_s_reduced[c]}}) {
-      // 3 reported total SDs, and 3% (the 2% target is for 1e6 photons; this run has
-      // 3e5 to stay quick, so its statistical part is ~1.8x larger).
+      // The targets: within 2% (every skin1 channel has alpha' >= 0.5) and the truth
+      // within 3 reported total SDs. (At 3e5 photons blue sigma_s' came out +1.2..+2.7% over
+      // three seeds, z up to 3.1: a small-sample bias of the fit that is gone at 1e6, +0.4%.)
       EXPECT_LT(std::abs(value - truth), 3 * sd) << "channel " << c << " " << value << " +- " << sd
                                                  << " truth " << truth;
-      EXPECT_LT(std::abs(value / truth - 1), 0.03) << "channel " << c;
+      EXPECT_LT(std::abs(value / truth - 1), 0.02) << "channel " << c;
     }
   }
 }

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <cstdio>
 #include <random>
 
 #include "lucent/materials/error.h"
@@ -72,8 +73,9 @@ TEST(RelativeSeCode, RoundTripsWithinItsStepAndMarksExtrapolation) {
   EXPECT_TRUE(std::isinf(decode_relative_se(kExtrapolatedEntry)));
 }
 
-// A small synthetic finished table: value(rho, u) = e^(-2 u rho) / (rho + 0.1), so that the
-// interpolant can be checked against the formula it was sampled from.
+// A small synthetic finished table: value(rho, u) = alpha' e^(-2 u rho + eta) / (rho + 0.1), whose
+// log value / alpha' is linear in u and eta (so interpolation there is exact) and steep and
+// curved in log rho like a real far field: a check of the annulus-average-to-point conversion.
 TransportTable synthetic_table() {
   TransportTable t;
   t.grid.u = {0, 0.1, 0.2, 0.4, 0.6, 0.8, 0.95};
@@ -94,9 +96,9 @@ TransportTable synthetic_table() {
           double avg = 0;
           for (int m = 0; m < 200; ++m) {
             const double r = std::sqrt(r0 * r0 + (m + 0.5) / 200 * (r1 * r1 - r0 * r0));
-            avg += std::exp(-2 * t.grid.u[k] * r) / (r + 0.1) * (q + 1) * eta / 200;
+            avg += (1 - t.grid.u[k] * t.grid.u[k]) * std::exp(-2 * t.grid.u[k] * r + eta) / (r + 0.1) * (q + 1) / 200;
           }
-          s.value[std::size_t(q)].push_back(float(avg));
+          s.value[std::size_t(q)].push_back(float(std::max(avg, 1e-37)));  // as the writer clamps
           s.se_code[std::size_t(q)].push_back(encode_relative_se(0.01, false));
         }
       }
@@ -114,22 +116,24 @@ TEST(TabulatedProfile, InterpolatesBinAveragesBackToPointValues) {
   for (double rho = 0.05; rho < 50; rho *= 1.13) {
     for (double u : {0.05, 0.3, 0.5, 0.7}) {
       const double a = 1 - u * u;
-      const double exact = std::exp(-2 * u * rho) / (rho + 0.1) * 1.3;
+      const double exact = a * std::exp(-2 * u * rho + 1.3) / (rho + 0.1);
       const double v = p.value(TableQuantity::kExitance, rho, a, 1.3);
       // Far out, log value falls by ~2 u rho: relative error stays small only up to the curvature
       // the u grid resolves; judge the near and middle field where it matters.
       if (2 * u * rho < 20) worst = std::max(worst, std::abs(v / exact - 1));
     }
   }
-  EXPECT_LT(worst, 0.01) << "the synthetic profile is smooth: interpolation within 1%";
+  // Measured 5.2e-4 (from 4% with a second-order bin-average correction in place of the
+  // fixed-point deconvolution); the bound leaves room for other compilers' rounding only.
+  EXPECT_LT(worst, 1e-3) << "annulus averages back to point values";
   // The radiance quantity is kept apart (twice the exitance in this table).
   EXPECT_NEAR(p.value(TableQuantity::kRadiance, 1.0, 0.91, 1.3) /
                   p.value(TableQuantity::kExitance, 1.0, 0.91, 1.3),
               2.0, 1e-6);
-  // Between eta slices: linear in eta in this table, reproduced to 1e-3.
+  // Between eta slices: log value linear in eta in this table, so reproduced exactly.
   EXPECT_NEAR(p.value(TableQuantity::kExitance, 1.0, 0.91, 1.45) /
                   p.value(TableQuantity::kExitance, 1.0, 0.91, 1.3),
-              1.45 / 1.3, 1e-3);
+              std::exp(0.15), 1e-6);  // float storage
 }
 
 TEST(TabulatedProfile, FiniteAtTheExtremes) {

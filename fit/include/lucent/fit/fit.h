@@ -40,6 +40,10 @@ struct FitOptions {
   double g = 0;
   /// The transport table; null: the shipped one (materials::default_transport_table()).
   const materials::TransportTable* table = nullptr;
+  /// The model-error work beside the solve: a diffusion model's cross-fit of the tabulated model,
+  /// the tabulated model's bootstrap over its table and accuracy refits, the g = 0.9 refit, the
+  /// adequacy of cheaper models. Off only to time the solve alone (bench_fit).
+  bool systematics = true;
   std::optional<double> ior;     ///< relative index; required unless the data carries it or fit_ior
   bool fit_ior = false;          ///< fit eta too (one for all channels)
   std::optional<bool> relative;  ///< fit a global scale; default: when the data is uncalibrated

@@ -5,6 +5,8 @@
 
 #include <array>
 #include <cmath>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -110,6 +112,10 @@ class TabulatedProfile {
   TabulatedProfile(const TransportTable& table, double g);
   /// The same profile with eta fixed (one slice: faster when eta is not fitted).
   TabulatedProfile at_eta(double eta) const;
+  /// A copy with every measured entry's log value moved by a normal draw of its relative standard
+  /// error (seeded): one realisation of the table's Monte Carlo noise, for propagating it into a
+  /// fit by a parametric bootstrap.
+  TabulatedProfile perturbed(std::uint64_t seed) const;
 
   double g() const { return g_; }
   double eta_min() const { return eta_.front(); }
@@ -150,8 +156,9 @@ class TabulatedProfile {
       last.first = J_ - 1, last.count = 1, last.w[0] = T(1);
       before.first = J_ - 2, before.count = 1, before.w[0] = T(1);
       const T f1 = at_x(last), f0 = at_x(before);
-      return f1 + (f1 - f0) / T(x_[std::size_t(J_) - 1] - x_[std::size_t(J_) - 2]) *
-                      (rho / T(std::exp(x_.back())) - T(1));
+      T slope = (f1 - f0) / T(x_[std::size_t(J_) - 1] - x_[std::size_t(J_) - 2]);
+      if (slope > T(0)) slope = T(0);  // beyond the table the profile can only fall
+      return f1 + slope * (rho / T(std::exp(x_.back())) - T(1));
     }
     return at_x(hermite_weights(x_, lr, true));
   }
@@ -186,6 +193,8 @@ class TabulatedProfile {
   /// The table's relative standard error near (rho, alpha', eta) (the largest of the entries the
   /// interpolation leans on most); infinity in an extrapolated tail.
   double relative_se(TableQuantity q, double rho, double alpha_prime, double eta) const;
+  /// The relative standard error of the table's total diffuse reflectance at the nearest nodes.
+  double total_relative_se(double alpha_prime, double eta) const;
 
  private:
   TabulatedProfile() = default;
@@ -198,7 +207,15 @@ class TabulatedProfile {
   std::vector<std::array<std::vector<double>, kTableQuantities>> f_;
   std::vector<std::array<std::vector<float>, kTableQuantities>> rel_se_;
   std::vector<std::vector<double>> log_total_;  // [slice][k]: log(total / alpha')
+  std::vector<std::vector<double>> total_rel_se_;  // [slice][k]
 };
+
+/// A prepared profile of `table` at g (and, when given, at a fixed eta), made once per (table, g,
+/// eta) and kept for the process: preparing one costs ~0.1 s (the annulus-average
+/// deconvolution), evaluating it microseconds. Thread-safe. Throws like the constructor.
+std::shared_ptr<const TabulatedProfile> cached_tabulated_profile(const TransportTable& table,
+                                                                 double g,
+                                                                 std::optional<double> eta = {});
 
 /// The tabulated model of one channel, in the shape of the other models: lengths in mm.
 template <typename T>
