@@ -97,11 +97,19 @@ struct ProfileResiduals {
         materials::Medium<T>::from_reduced(exp(ab[0]), exp(ab[1]), eta);
     const T log_front = log_scale + log(detail::fresnel_factor(obs->geometry, eta, model));
     const std::size_t n = obs->log_value.size();
+    // The tabulated model is built once per evaluation (its rows at these coefficients), then
+    // read at every sample.
+    std::optional<materials::TabulatedModel<T>> tab;
+    if (model == FitModel::kTabulated) tab.emplace(*table, medium);
+    const materials::TableQuantity q = detail::table_quantity(obs->geometry);
     for (std::size_t i = 0; i < n; ++i) {
-      const T v = detail::model_value(model, table, medium, obs->geometry, obs->radial,
-                                      obs->radial ? obs->r[i] : 0.0, obs->radial ? obs->r0[i] : 0.0,
-                                      obs->radial ? obs->r1[i] : 0.0, obs->x[i], obs->y[i],
-                                      obs->pixel, gl);
+      const T v =
+          tab ? (obs->radial ? detail::tabulated_annulus(*tab, q, obs->r[i], obs->r0[i], obs->r1[i], gl)
+                             : detail::tabulated_pixel(*tab, q, obs->x[i], obs->y[i], obs->pixel, gl))
+              : detail::model_value(model, table, medium, obs->geometry, obs->radial,
+                                    obs->radial ? obs->r[i] : 0.0, obs->radial ? obs->r0[i] : 0.0,
+                                    obs->radial ? obs->r1[i] : 0.0, obs->x[i], obs->y[i],
+                                    obs->pixel, gl);
       T scaled = v;
       if (perturbation.epsilon != 0) {
         const double r = obs->radial ? obs->r[i] : std::hypot(obs->x[i], obs->y[i]);
@@ -806,8 +814,7 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
     }
     why << "; no accurate model: " << table_problem;
     result.reason = why.str();
-    result.notes.push_back("no model exact to transport for these data (" + table_problem +
-                           "): the diffusion model's own error is not in the uncertainty");
+    result.notes.push_back("no model exact to transport for these data (" + table_problem + ")");
   }
   if (tab_ok && options.systematics && result.chosen.model == FitModel::kTabulated) {
     // The tabulated model's own error, two parts in quadrature. (1) The table's Monte Carlo noise,

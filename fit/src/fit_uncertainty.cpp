@@ -55,6 +55,24 @@ void finish_uncertainty(FitResult& result, const std::vector<ProfileData>& data,
   };
   for (ModelFit& f : result.candidates) finish(f);
   finish(result.chosen);
+  if (!accurate && result.candidates.size() == 2) {
+    // No model exact to transport for these data (oblique 2D, or eta outside the table): the two
+    // diffusion models' disagreement is the only measure of their error there is, and it is
+    // carried as the systematic rather than pretending the chosen model is exact.
+    const ModelFit& other = result.candidates[0].model == result.chosen.model
+                                ? result.candidates[1]
+                                : result.candidates[0];
+    for (int c = 0; c < 3; ++c) {
+      ChannelFit& ch = result.chosen.channels[c];
+      ch.sd_sys_sigma_a = std::abs(ch.sigma_a - other.channels[c].sigma_a);
+      ch.sd_sys_sigma_s_reduced = std::abs(ch.sigma_s_reduced - other.channels[c].sigma_s_reduced);
+      ch.sd_sigma_a = std::hypot(ch.sd_stat_sigma_a, ch.sd_sys_sigma_a);
+      ch.sd_sigma_s_reduced = std::hypot(ch.sd_stat_sigma_s_reduced, ch.sd_sys_sigma_s_reduced);
+    }
+    result.notes.push_back(
+        "systematic: the disagreement of the standard and directional dipoles on these data "
+        "(no model exact to transport applies), so the total SD is wide where they differ");
+  }
 
   const ModelFit& f = result.chosen;
   for (int c = 0; c < 3; ++c) {

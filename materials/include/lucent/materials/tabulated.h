@@ -3,6 +3,7 @@
 // exact derivatives of the interpolant through a fit.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <memory>
@@ -102,6 +103,45 @@ NodeWeights<T> hermite_weights(const std::vector<double>& x, const T& t, bool ex
   return r;
 }
 
+/// The value of a scalar or of a Jet's real part (for choosing a cell; never differentiated).
+inline double scalar_of(double v) { return v; }
+inline double scalar_of(float v) { return v; }
+template <typename T>
+double scalar_of(const T& v) {
+  return v.a;
+}
+
+/// hermite_weights for nodes x0 + i h, i < n (n >= 3): the cell found by arithmetic instead of a
+/// search, the tangents central differences (what the general rule gives on uniform nodes).
+template <typename T>
+NodeWeights<T> uniform_hermite_weights(double x0, double h, int n, const T& t) {
+  NodeWeights<T> r;
+  const double pos = (scalar_of(t) - x0) / h;
+  if (!(pos > 0) || !(pos < n - 1)) {  // outside: linear from the end cell
+    const int i = pos > 0 ? n - 2 : 0;
+    const T s = (t - T(x0 + i * h)) / T(h);
+    r.first = i, r.count = 2, r.w[0] = T(1) - s, r.w[1] = s;
+    return r;
+  }
+  const int i = std::min(int(pos), n - 2);
+  const T s = (t - T(x0 + i * h)) / T(h);
+  const T s2 = s * s, s3 = s2 * s;
+  const T h00 = T(2) * s3 - T(3) * s2 + T(1), h10 = s3 - T(2) * s2 + s;
+  const T h01 = T(-2) * s3 + T(3) * s2, h11 = s3 - s2;
+  const T half(0.5);
+  if (i == 0) {
+    r.first = 0, r.count = 3;
+    r.w = {h00 - h10 - half * h11, h01 + h10, half * h11, T(0)};
+  } else if (i + 1 == n - 1) {
+    r.first = i - 1, r.count = 3;
+    r.w = {-half * h10, h00 - h11, h01 + half * h10 + h11, T(0)};
+  } else {
+    r.first = i - 1, r.count = 4;
+    r.w = {-half * h10, h00 - half * h11, h01 + half * h10, half * h11};
+  }
+  return r;
+}
+
 /// A transport table at one g, ready to evaluate: log(value / alpha') at the point centres of the
 /// radius bins (the annulus averages of the file turned into point values by a second-order
 /// correction), per eta slice.
@@ -161,6 +201,45 @@ class TabulatedProfile {
       return f1 + slope * (rho / T(std::exp(x_.back())) - T(1));
     }
     return at_x(hermite_weights(x_, lr, true));
+  }
+
+  /// The rows of log(value / alpha') over the bin centres at (u, eta), both quantities: what a
+  /// model of fixed coefficients evaluates at many radii (combined once, then one 1D
+  /// interpolation per radius).
+  template <typename T>
+  void rows_at(const T& u, const T& eta, std::array<std::vector<T>, kTableQuantities>& rows) const {
+    const NodeWeights<T> we = hermite_weights(eta_, eta, false);
+    const T uc = u < T(u_.back()) ? u : T(u_.back());
+    const NodeWeights<T> wu = hermite_weights(u_, uc, false);
+    for (int q = 0; q < kTableQuantities; ++q) {
+      std::vector<T>& row = rows[std::size_t(q)];
+      row.assign(std::size_t(J_), T(0));
+      for (int a = 0; a < we.count; ++a) {
+        const std::vector<double>& f = f_[std::size_t(we.first + a)][std::size_t(q)];
+        for (int b = 0; b < wu.count; ++b) {
+          const T w = we.w[std::size_t(a)] * wu.w[std::size_t(b)];
+          const double* src = f.data() + std::size_t(wu.first + b) * std::size_t(J_);
+          for (int j = 0; j < J_; ++j) row[std::size_t(j)] += w * T(src[j]);
+        }
+      }
+    }
+  }
+
+  /// A row from rows_at evaluated at rho, with log_value's rules beyond the ends.
+  template <typename T>
+  T row_log_value(const std::vector<T>& row, const T& rho) const {
+    using std::log;
+    const T lr = log(rho);
+    if (lr > T(x_.back())) {
+      const std::size_t J = std::size_t(J_);
+      T slope = (row[J - 1] - row[J - 2]) / T(x_[J - 1] - x_[J - 2]);
+      if (slope > T(0)) slope = T(0);
+      return row[J - 1] + slope * (rho / T(std::exp(x_.back())) - T(1));
+    }
+    const NodeWeights<T> wx = uniform_hermite_weights(x_.front(), x_[1] - x_[0], J_, lr);
+    T sum(0);
+    for (int c = 0; c < wx.count; ++c) sum += wx.w[std::size_t(c)] * row[std::size_t(wx.first + c)];
+    return sum;
   }
 
   /// value / sigma_t'^2 (exitance R, or pi L along the normal), per unit power entering.
@@ -224,8 +303,14 @@ class TabulatedModel {
   /// The profile's g is the medium's anisotropy (the medium's own g is not used: sigma_s' is).
   TabulatedModel(const TabulatedProfile& profile, const Medium<T>& m)
       : profile_(&profile), eta_(m.eta) {
+    using std::sqrt;
     sigma_t_reduced_ = m.sigma_a + m.sigma_s * (T(1) - m.g);
     alpha_prime_ = sigma_t_reduced_ > T(0) ? m.sigma_s * (T(1) - m.g) / sigma_t_reduced_ : T(0);
+    if (alpha_prime_ > T(0)) {
+      const T one_minus = T(1) - alpha_prime_;
+      profile.rows_at(one_minus > T(0) ? sqrt(one_minus) : T(0), eta_, rows_);
+      scale_ = sigma_t_reduced_ * sigma_t_reduced_ * alpha_prime_;
+    }
   }
 
   /// Radial exitance R(r) per mm^2 per unit power entering.
@@ -236,8 +321,8 @@ class TabulatedModel {
     if (!(alpha_prime_ > T(0))) return T(0);
     const T rho = r_mm * sigma_t_reduced_;
     const T floor(1e-12);  // r = 0: the innermost bin's power law would diverge
-    return sigma_t_reduced_ * sigma_t_reduced_ *
-           profile_->value(q, rho > floor ? rho : floor, alpha_prime_, eta_);
+    using std::exp;
+    return scale_ * exp(profile_->row_log_value(rows_[std::size_t(q)], rho > floor ? rho : floor));
   }
   T total_diffuse_reflectance() const {
     if (!(alpha_prime_ > T(0))) return T(0);
@@ -248,7 +333,8 @@ class TabulatedModel {
 
  private:
   const TabulatedProfile* profile_;
-  T eta_, sigma_t_reduced_, alpha_prime_;
+  T eta_, sigma_t_reduced_, alpha_prime_, scale_{0};
+  std::array<std::vector<T>, kTableQuantities> rows_;
 };
 
 }  // namespace lucent::materials
