@@ -100,12 +100,17 @@ struct ProfileResiduals {
     // The tabulated model is built once per evaluation (its rows at these coefficients), then
     // read at every sample.
     std::optional<materials::TabulatedModel<T>> tab;
+    std::optional<materials::DirectionalDipole<T>> dd;  // oblique 2D data: the corrected ddipole
     if (model == FitModel::kTabulated) tab.emplace(*table, medium);
+    const bool oblique = !obs->radial && obs->geometry.cos_incidence < 0.9999;
+    if (tab && oblique) dd.emplace(medium);
     const materials::TableQuantity q = detail::table_quantity(obs->geometry);
     for (std::size_t i = 0; i < n; ++i) {
       const T v =
-          tab ? (obs->radial ? detail::tabulated_annulus(*tab, q, obs->r[i], obs->r0[i], obs->r1[i], gl)
-                             : detail::tabulated_pixel(*tab, q, obs->x[i], obs->y[i], obs->pixel, gl))
+          tab ? (obs->radial  ? detail::tabulated_annulus(*tab, q, obs->r[i], obs->r0[i], obs->r1[i], gl)
+                 : oblique ? detail::corrected_ddipole_pixel(*tab, *dd, q, obs->geometry, obs->x[i],
+                                                             obs->y[i], obs->pixel, gl)
+                           : detail::tabulated_pixel(*tab, q, obs->x[i], obs->y[i], obs->pixel, gl))
               : detail::model_value(model, table, medium, obs->geometry, obs->radial,
                                     obs->radial ? obs->r[i] : 0.0, obs->radial ? obs->r0[i] : 0.0,
                                     obs->radial ? obs->r1[i] : 0.0, obs->x[i], obs->y[i],
@@ -525,6 +530,14 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
       fit.undetermined.push_back(describe_combination(svd.matrixV().col(i), names));
     }
   }
+  // A parameter that leans on an undetermined direction is known to no better than a factor e:
+  // its log-space variance is at least 1 (reported, never a deceptive 0).
+  std::vector<double> floor_var(std::size_t(sv.size() ? svd.matrixV().rows() : 0), 0.0);
+  for (int i = 0; i < sv.size(); ++i) {
+    if (inv2(i) != 0) continue;
+    for (int j = 0; j < svd.matrixV().rows(); ++j)
+      if (std::abs(svd.matrixV()(j, i)) > 0.3) floor_var[std::size_t(j)] = 1.0;
+  }
   // (J^T J)^+ from the SVD: the covariance of the free parameters when the standard errors are
   // honest; directions the data does not determine are left out and reported instead.
   covariance = svd.matrixV() * inv2.asDiagonal() * svd.matrixV().transpose();
@@ -546,9 +559,16 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
     if (!channels[c]) continue;
     ch.sigma_a = std::exp(p.ab[c][0]);
     ch.sigma_s_reduced = std::exp(p.ab[c][1]);
-    const double va = covariance(k, k), vs = covariance(k + 1, k + 1);
+    const double va = std::max(covariance(k, k), floor_var[std::size_t(k)]);
+    const double vs = std::max(covariance(k + 1, k + 1), floor_var[std::size_t(k) + 1]);
     ch.sd_sigma_a = ch.sigma_a * std::sqrt(std::max(0.0, va));  // delta method from log space
     ch.sd_sigma_s_reduced = ch.sigma_s_reduced * std::sqrt(std::max(0.0, vs));
+    if (floor_var[std::size_t(k)] > 0 && range_end[c] > 0) {
+      // An undetermined sigma_a may have run to ~0: bound it instead by the absorption a profile
+      // of this reach would just show, sigma_tr R = 1, i.e. sigma_a = 1 / (3 sigma_t' R^2).
+      const double st = ch.sigma_a + ch.sigma_s_reduced;
+      ch.sd_sigma_a = std::max(ch.sd_sigma_a, 1.0 / (3 * st * range_end[c] * range_end[c]));
+    }
     ch.correlation = va > 0 && vs > 0 ? covariance(k, k + 1) / std::sqrt(va * vs) : 0.0;
     ch.samples = samples[c];
     k += 2;
@@ -643,6 +663,9 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
   for (const ProfileData& d : data) {
     for (int c = 0; c < 3; ++c) channels[c] = channels[c] || d.channels[c];
   }
+  if (!channels[0] && !channels[1] && !channels[2])
+    throw Error(data.front().source + ": no channel holds data (every standard error is 0): "
+                "nothing to fit");
 
   FitResult result;
   std::array<StartValues, 3> start;
@@ -664,9 +687,13 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
     }
   }
   // The tabulated model applies to radial profiles at normal incidence and normal view.
-  bool radial_normal = true;
+  // At oblique incidence (2D samples, camera along the normal) it corrects the directional dipole.
+  bool radial_normal = true, oblique = false;
   for (const ProfileData& d : data) {
-    if (d.incidence_polar_deg > 0.5 || (!d.exitance && d.view_deg > 0.5)) radial_normal = false;
+    const bool two_d = d.samples_2d.has_value() && d.incidence_polar_deg > 0;
+    oblique = oblique || two_d;
+    if ((d.incidence_polar_deg > 0.5 && !two_d) || (!d.exitance && d.view_deg > 0.5))
+      radial_normal = false;
   }
   std::shared_ptr<const materials::TabulatedProfile> full, fixed;
   std::string table_problem;
@@ -687,11 +714,14 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
         }
       }
     } catch (const Error& e) {
+      // --g only means something to the tabulated model: a g the table lacks is an error, not a
+      // quiet fall-back to the dipoles.
+      if (std::string(e.what()).rfind("--g", 0) == 0) throw;
       table_problem = e.what();
     }
   } else {
     table_problem =
-        "the tabulated model is for radial profiles at normal incidence and normal view";
+        "the tabulated model needs a camera along the normal, and oblique incidence as 2D samples";
   }
   const bool tab_ok = full && table_problem.empty();
   if (options.model == FitModel::kTabulated && !tab_ok)
@@ -739,6 +769,37 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
           solve(data, options, m, t, eta0, relative, ex, searched, channels, &below_noise);
       if (other.chi2 < best.chi2) best = other;
     }
+    poor = !best.converged;
+    for (int c = 0; c < 3; ++c) poor = poor || (channels[c] && best.channels[c].residual_rms > 3.0);
+    if (poor && m == FitModel::kTabulated) {
+      // Still lost (its start came from a dipole fit that failed, e.g. a dipole valley far from
+      // the truth): starts spread over alpha' at the data's far-field sigma_tr, the best of them
+      // chosen per channel (the channels' costs are independent), then one solve from there.
+      std::array<StartValues, 3> composite = start;
+      std::array<double, 3> best_rms{INFINITY, INFINITY, INFINITY};
+      for (double a : {0.3, 0.6, 0.8, 0.9, 0.95, 0.98, 0.995, 0.999}) {
+        std::array<StartValues, 3> st = start;
+        for (int c = 0; c < 3; ++c) {
+          if (!channels[c]) continue;
+          const double sa = start[c].sigma_a, ss = start[c].sigma_s_reduced;
+          const double sigma_tr = std::sqrt(3 * sa * (sa + ss));
+          const double st_reduced = sigma_tr / std::sqrt(3 * (1 - a));
+          st[c].sigma_a = (1 - a) * st_reduced;
+          st[c].sigma_s_reduced = a * st_reduced;
+        }
+        const ModelFit f = solve(data, options, m, t, eta0, relative, ex, st, channels, &below_noise);
+        for (int c = 0; c < 3; ++c) {
+          if (channels[c] && f.channels[c].residual_rms < best_rms[c]) {
+            best_rms[c] = f.channels[c].residual_rms;
+            composite[c].sigma_a = f.channels[c].sigma_a;
+            composite[c].sigma_s_reduced = f.channels[c].sigma_s_reduced;
+          }
+        }
+      }
+      ModelFit other =
+          solve(data, options, m, t, eta0, relative, ex, composite, channels, &below_noise);
+      if (other.chi2 < best.chi2) best = other;
+    }
     return best;
   };
   const auto started_from = [&](const ModelFit& f) {
@@ -784,7 +845,12 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
 
   if (tab_ok) {
     result.chosen = result.candidates.front();
-    if (options.model == FitModel::kAuto) {
+    if (options.model == FitModel::kAuto && oblique) {
+      result.reason =
+          "tabulated: oblique incidence, the directional dipole corrected by lucent's Monte Carlo "
+          "transport table (g = " + std::to_string(options.g).substr(0, 4) +
+          ") to transport at normal incidence; the cheaper models are judged against it";
+    } else if (options.model == FitModel::kAuto) {
       result.reason =
           "tabulated: exact to radiative transfer for a radial profile at normal incidence "
           "(lucent's Monte Carlo transport table at g = " + std::to_string(options.g).substr(0, 4) +

@@ -116,7 +116,7 @@ ProfileData load_csv(const std::filesystem::path& path) {
   const int inner = has("r_inner_mm") ? column["r_inner_mm"] : -1;
   const int outer = has("r_outer_mm") ? column["r_outer_mm"] : -1;
   bool assumed_errors = false;
-  int zero_se_rows = 0;
+  std::array<int, 3> zero_se{};
   while (std::getline(in, line)) {
     ++line_number;
     if (trim(line).empty() || trim(line)[0] == '#') continue;
@@ -139,23 +139,19 @@ ProfileData load_csv(const std::filesystem::path& path) {
     const double r = number(column["r_mm"]);
     if (r < 0) throw Error(where + "r_mm must be >= 0");
     std::array<double, 3> v{}, se{};
-    bool zero = false;
     for (int c = 0; c < 3; ++c) {
       v[c] = value_col[c] >= 0 ? number(value_col[c]) : 0.0;
       if (se_col[c] >= 0) {
         se[c] = number(se_col[c]);
         if (se[c] < 0)
           throw Error(where + "column " + header[se_col[c]] + ": expected a standard error >= 0");
-        // 0: a Monte Carlo bin no photon reached (value 0 too); skipped, not fitted.
-        if (se[c] == 0 && d.channels[c]) zero = true;
+        // 0: a Monte Carlo bin no photon reached (value 0 too): kept out of the fit (the fit
+        // uses only samples with a standard error > 0), counted.
+        if (se[c] == 0 && d.channels[c]) ++zero_se[c];
       } else {
         se[c] = 0.05 * std::abs(v[c]);  // documented assumption: 5% relative error
         assumed_errors = true;
       }
-    }
-    if (zero) {
-      ++zero_se_rows;
-      continue;
     }
     d.radial.r_mm.push_back(r);
     d.radial.r_inner_mm.push_back(inner >= 0 ? number(inner) : r);
@@ -167,9 +163,20 @@ ProfileData load_csv(const std::filesystem::path& path) {
   }
   if (assumed_errors)
     d.notes.push_back(source + ": no standard-error columns; 5% relative errors assumed");
-  if (zero_se_rows > 0)
-    d.notes.push_back(source + ": " + std::to_string(zero_se_rows) +
-                      " rows with a zero standard error (no data) skipped");
+  const char* names[3] = {"R", "G", "B"};
+  for (int c = 0; c < 3; ++c) {
+    if (!d.channels[c] || zero_se[c] == 0) continue;
+    if (zero_se[c] == int(d.radial.size())) {
+      // No bin holds light: a channel that does not scatter (the wine's green and blue). Not
+      // fitted; the material gets no scattering there.
+      d.channels[c] = false;
+      d.notes.push_back(source + ": channel " + names[c] +
+                        " holds no data (every standard error is 0): not fitted");
+    } else {
+      d.notes.push_back(source + ": channel " + names[c] + ": " + std::to_string(zero_se[c]) +
+                        " bins with a zero standard error (no data) skipped");
+    }
+  }
   if (d.radial.size() == 0) throw Error(source + ": the profile is empty (a header and no rows)");
   return d;
 }

@@ -222,6 +222,13 @@ TEST(Fit, ObliqueCapturesFitJointlyWithTheDirectionalDipole) {
   FitOptions o;
   o.model = FitModel::kAuto;
   o.exclude_radius_mm = 0;
+  // Auto takes the accurate model for oblique 2D data: the table-corrected directional dipole.
+  const FitResult automatic =
+      fit_profiles({oblique_profile(m, 45, 0), oblique_profile(m, 30, 90)}, o);
+  EXPECT_EQ(automatic.chosen.model, FitModel::kTabulated) << automatic.reason;
+  EXPECT_NE(automatic.reason.find("oblique"), std::string::npos) << automatic.reason;
+  // These data are the directional dipole's own: asked for, it recovers them exactly.
+  o.model = FitModel::kDirectionalDipole;
   const FitResult r = fit_profiles({oblique_profile(m, 45, 0), oblique_profile(m, 30, 90)}, o);
   EXPECT_EQ(r.chosen.model, FitModel::kDirectionalDipole) << r.reason;
   for (int c = 0; c < 3; ++c) {
