@@ -1,0 +1,610 @@
+// The Ceres problem of a fit: residuals of every model, the solve, covariance and per-channel
+// statistics (fit_solve.h).
+#include "fit_solve.h"
+
+#include <ceres/ceres.h>
+#include <ceres/covariance.h>
+#include <glog/logging.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <numbers>
+#include <sstream>
+
+#include "dipole_gradient.h"
+#include "fit_start.h"
+#include "lucent/materials/albedo.h"
+#include "lucent/materials/tabulated.h"
+#include "lucent/materials/transport_table.h"
+#include "lucent/materials/error.h"
+#include "lucent/version.h"
+#include "model_prediction.h"
+
+namespace lucent::fit {
+namespace {
+
+using detail::CaptureGeometry;
+using detail::GaussLegendre;
+using detail::ModelPerturbation;
+using detail::start_values;
+using detail::StartValues;
+
+constexpr double kDegree = std::numbers::pi / 180.0;
+
+CaptureGeometry geometry_of(const ProfileData& d) {
+  CaptureGeometry g;
+  const double theta = d.incidence_polar_deg * kDegree, phi = d.incidence_azimuth_deg * kDegree;
+  g.cos_incidence = std::cos(theta);
+  g.cos_view = std::cos(d.view_deg * kDegree);
+  // The beam travels toward azimuth phi, so the light sits the other way.
+  g.w_i = {-std::sin(theta) * std::cos(phi), -std::sin(theta) * std::sin(phi), std::cos(theta)};
+  g.exitance = d.exitance;
+  g.per_incident_power = d.per_incident_power;
+  return g;
+}
+
+// What one residual block measures: a run of radial bins or 2D samples of one channel of one
+// capture.
+struct Observations {
+  bool radial = true;
+  CaptureGeometry geometry;
+  std::vector<double> r, r0, r1;   // radial
+  std::vector<double> x, y;        // 2D
+  double pixel = 0;                // footprint side of the pixels behind the samples, mm
+  std::vector<double> log_value;   // log of the measurement
+  std::vector<double> inv_rel_se;  // value / standard error: weights the log-ratio
+  std::vector<double> data_rel_se;  // the data's own relative standard error (before the table's)
+};
+
+// Residuals (log model - log data) * value / se: the log-ratio in units of the relative standard
+// error. Parameters: {log sigma_a, log sigma_s'}, {log scale}, {eta}.
+struct ProfileResiduals {
+  const Observations* obs;
+  FitModel model;
+  GaussLegendre gl;
+  const materials::TabulatedProfile* table = nullptr;  // kTabulated only
+  ModelPerturbation perturbation{};
+
+  template <typename T>
+  bool operator()(const T* const ab, const T* const log_scale, const T* const eta,
+                  T* residual) const {
+    return evaluate(ab, log_scale[0], eta[0], residual);
+  }
+
+  template <typename T>
+  bool evaluate(const T* const ab, const T& log_scale, const T& eta, T* residual) const {
+    using std::exp;
+    using std::log;
+    const materials::Medium<T> medium =
+        materials::Medium<T>::from_reduced(exp(ab[0]), exp(ab[1]), eta);
+    const T log_front = log_scale + log(detail::fresnel_factor(obs->geometry, eta, model));
+    const std::size_t n = obs->log_value.size();
+    // The tabulated model is built once per evaluation (its rows at these coefficients), then
+    // read at every sample.
+    std::optional<materials::TabulatedModel<T>> tab;
+    std::optional<materials::DirectionalDipole<T>> dd;  // oblique 2D data: the corrected ddipole
+    if (model == FitModel::kTabulated) tab.emplace(*table, medium);
+    const bool oblique = !obs->radial && obs->geometry.cos_incidence < 0.9999;
+    if (tab && oblique) dd.emplace(medium);
+    const materials::TableQuantity q = detail::table_quantity(obs->geometry);
+    for (std::size_t i = 0; i < n; ++i) {
+      const T v =
+          tab ? (obs->radial  ? detail::tabulated_annulus(*tab, q, obs->r[i], obs->r0[i], obs->r1[i], gl)
+                 : oblique ? detail::corrected_ddipole_pixel(*tab, *dd, q, obs->geometry, obs->x[i],
+                                                             obs->y[i], obs->pixel, gl)
+                           : detail::tabulated_pixel(*tab, q, obs->x[i], obs->y[i], obs->pixel, gl))
+              : detail::model_value(model, table, medium, obs->geometry, obs->radial,
+                                    obs->radial ? obs->r[i] : 0.0, obs->radial ? obs->r0[i] : 0.0,
+                                    obs->radial ? obs->r1[i] : 0.0, obs->x[i], obs->y[i],
+                                    obs->pixel, gl);
+      T scaled = v;
+      if (perturbation.epsilon != 0) {
+        const double r = obs->radial ? obs->r[i] : std::hypot(obs->x[i], obs->y[i]);
+        scaled *= perturbation.factor(T(r) * (medium.sigma_a + medium.sigma_s));
+      }
+      residual[i] = (log_front + log(scaled + T(1e-300)) - obs->log_value[i]) * obs->inv_rel_se[i];
+    }
+    return true;
+  }
+};
+
+// The common case, scale and eta held: derivatives in the two channel parameters only (Jets of 2,
+// not 4: half the work).
+struct ChannelResiduals {
+  ProfileResiduals full;
+  const double* log_scale;
+  const double* eta;
+
+  template <typename T>
+  bool operator()(const T* const ab, T* residual) const {
+    return full.evaluate(ab, T(*log_scale), T(*eta), residual);
+  }
+};
+
+// The standard dipole with a hand-written Jacobian (scale and eta held): annuli, or pixel
+// footprints.
+class DipoleRadialCost : public ceres::CostFunction {
+ public:
+  // Parameter blocks: {log sigma_a, log sigma_s'} and {log scale}.
+  DipoleRadialCost(const Observations* obs, GaussLegendre gl, const double* eta)
+      : obs_(obs), gl_(gl), eta_(eta) {
+    set_num_residuals(int(obs->log_value.size()));
+    mutable_parameter_block_sizes()->push_back(2);
+    mutable_parameter_block_sizes()->push_back(1);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const double* ab = parameters[0];
+    const detail::DipoleGradientModel model(std::exp(ab[0]), std::exp(ab[1]), *eta_);
+    const double log_front =
+        parameters[1][0] +
+        std::log(detail::fresnel_factor(obs_->geometry, *eta_, FitModel::kDipole));
+    for (std::size_t i = 0; i < obs_->log_value.size(); ++i) {
+      detail::DipoleGradient sum;
+      const auto add = [&](double weight, double r) {
+        const detail::DipoleGradient g = model.at(r);
+        sum.value += weight * g.value;
+        sum.d_log_sigma_a += weight * g.d_log_sigma_a;
+        sum.d_log_sigma_s += weight * g.d_log_sigma_s;
+      };
+      if (!obs_->radial) {  // a pixel footprint (2D sample, or a bin of pixel averages)
+        const double p = obs_->pixel;
+        if (!(p > 0)) {
+          add(1.0, std::hypot(obs_->x[i], obs_->y[i]));
+        } else {
+          for (int a = 0; a < gl_.order; ++a) {
+            for (int b = 0; b < gl_.order; ++b) {
+              add(gl_.weight[a] * gl_.weight[b], std::hypot(obs_->x[i] + (gl_.node[a] - 0.5) * p,
+                                                            obs_->y[i] + (gl_.node[b] - 0.5) * p));
+            }
+          }
+        }
+      } else if (!(obs_->r1[i] > obs_->r0[i])) {
+        add(1.0, obs_->r[i]);
+      } else {
+        const double r0 = obs_->r0[i], r1 = obs_->r1[i];
+        for (int k = 0; k < gl_.order; ++k)
+          add(gl_.weight[k], std::sqrt(r0 * r0 + gl_.node[k] * (r1 * r1 - r0 * r0)));
+      }
+      const double v = sum.value + 1e-300;
+      const double w = obs_->inv_rel_se[i];
+      residuals[i] = (log_front + std::log(v) - obs_->log_value[i]) * w;
+      if (jacobians && jacobians[0]) {
+        jacobians[0][2 * i] = w * sum.d_log_sigma_a / v;
+        jacobians[0][2 * i + 1] = w * sum.d_log_sigma_s / v;
+      }
+      if (jacobians && jacobians[1]) jacobians[1][i] = w;
+    }
+    return true;
+  }
+
+ private:
+  const Observations* obs_;
+  GaussLegendre gl_;
+  const double* eta_;
+};
+
+// Prior on a calibration scale: log scale ~ N(0, relative_se).
+struct ScalePrior {
+  double inverse_se;
+  template <typename T>
+  bool operator()(const T* const log_scale, T* residual) const {
+    residual[0] = log_scale[0] * inverse_se;
+    return true;
+  }
+};
+
+}  // namespace
+
+GaussLegendre detail::gauss_legendre(int order) {
+  // Golub-Welsch: nodes are the eigenvalues of the Jacobi matrix of the Legendre recurrence,
+  // weights twice the squared first components of its eigenvectors; mapped from [-1, 1] to [0, 1].
+  order = std::clamp(order, 1, 8);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(order, order);
+  for (int k = 1; k < order; ++k) {
+    const double beta = k / std::sqrt(4.0 * k * k - 1.0);
+    J(k, k - 1) = J(k - 1, k) = beta;
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(J);
+  GaussLegendre gl;
+  gl.order = order;
+  for (int i = 0; i < order; ++i) {
+    gl.node[i] = 0.5 * (eig.eigenvalues()(i) + 1.0);
+    gl.weight[i] = eig.eigenvectors()(0, i) * eig.eigenvectors()(0, i);  // 2 v^2 / 2
+  }
+  return gl;
+}
+
+QualitySettings quality_settings(Quality quality) {
+  QualitySettings s;
+  switch (quality) {
+    case Quality::kFast:
+      s.footprint_order = 1;
+      s.max_samples_2d = 1024;
+      s.function_tolerance = 1e-6;
+      s.parameter_tolerance = 1e-6;
+      s.max_iterations = 50;
+      break;
+    case Quality::kBalanced:
+      s.footprint_order = 2;  // two Gauss points are exact to fourth order across a bin
+      break;
+    case Quality::kAccurate:
+      s.footprint_order = 6;
+      s.max_samples_2d = 1 << 30;
+      s.function_tolerance = 1e-14;
+      s.parameter_tolerance = 1e-14;
+      s.max_iterations = 500;
+      break;
+  }
+  return s;
+}
+
+namespace {
+
+const char* kChannelNames[3] = {"R", "G", "B"};
+
+
+// Usable observations of one channel of one capture, after exclusion and the noise floor.
+Observations observations_for(const ProfileData& d, int c, double exclude_mm, bool use_2d,
+                              const QualitySettings& q, int* below_noise) {
+  Observations o;
+  o.geometry = geometry_of(d);
+  const auto keep = [&](double v, double se) {
+    if (!(se > 0) || !std::isfinite(v) || !std::isfinite(se)) return false;
+    if (v < 2 * se) {  // below the noise floor: a log-ratio there is meaningless
+      ++*below_noise;
+      return false;
+    }
+    return true;
+  };
+  if (use_2d) {
+    const Samples2d& s = *d.samples_2d;
+    o.radial = false;
+    o.pixel = s.pixel_mm;
+    std::vector<std::size_t> idx;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      if (std::hypot(s.x_mm[i], s.y_mm[i]) >= exclude_mm &&
+          keep(s.value[c][i], s.standard_error[c][i])) {
+        idx.push_back(i);
+      }
+    }
+    const std::size_t stride =
+        std::max<std::size_t>(1, (idx.size() + q.max_samples_2d - 1) / q.max_samples_2d);
+    for (std::size_t k = 0; k < idx.size(); k += stride) {
+      const std::size_t i = idx[k];
+      o.x.push_back(s.x_mm[i]);
+      o.y.push_back(s.y_mm[i]);
+      o.log_value.push_back(std::log(s.value[c][i]));
+      o.inv_rel_se.push_back(s.value[c][i] / s.standard_error[c][i]);
+      o.data_rel_se.push_back(s.standard_error[c][i] / s.value[c][i]);
+    }
+  } else {
+    const RadialBins& b = d.radial;
+    if (b.pixel_mm > 0) {
+      // Bins of pixel averages: model each as a pixel footprint at the bin's mean radius.
+      o.radial = false;
+      o.pixel = b.pixel_mm;
+    }
+    // The usable range ends where the profile sinks into the noise: at the first two consecutive
+    // bins below the noise floor. Bins beyond are not fitted even when noise lifts one above it
+    // (keeping those would select upward fluctuations and bias the tail).
+    bool ended = false;
+    for (std::size_t i = 0; i < b.size(); ++i) {
+      if (b.r_mm[i] < exclude_mm) continue;
+      const auto below = [&](std::size_t k) {
+        return !(b.value[c][k] >= 2 * b.standard_error[c][k]) || !(b.standard_error[c][k] > 0);
+      };
+      if (!ended && below(i) && (i + 1 == b.size() || below(i + 1))) ended = true;
+      if (ended) {
+        ++*below_noise;
+        continue;
+      }
+      if (!keep(b.value[c][i], b.standard_error[c][i])) continue;
+      o.r.push_back(b.r_mm[i]);
+      o.r0.push_back(b.r_inner_mm[i]);
+      o.r1.push_back(b.r_outer_mm[i]);
+      o.x.push_back(b.r_mm[i]);
+      o.y.push_back(0.0);
+      o.log_value.push_back(std::log(b.value[c][i]));
+      o.inv_rel_se.push_back(b.value[c][i] / b.standard_error[c][i]);
+      o.data_rel_se.push_back(b.standard_error[c][i] / b.value[c][i]);
+    }
+  }
+  return o;
+}
+
+struct Problem {
+  std::array<std::array<double, 2>, 3> ab{};
+  double log_scale = 0;
+  double eta = 1.3;
+  std::deque<std::array<double, 3>> calibration;  // per profile and channel: log scale with a prior
+  std::deque<Observations> observations;          // owned: residual blocks point into it (stable)
+};
+
+// Describes a null-space vector over the free parameters.
+std::string describe_combination(const Eigen::VectorXd& v, const std::vector<std::string>& names) {
+  std::ostringstream s;
+  s.precision(2);
+  bool first = true;
+  for (int i = 0; i < v.size(); ++i) {
+    if (std::abs(v(i)) < 0.05) continue;
+    s << (first ? "" : (v(i) < 0 ? " - " : " + ")) << (first && v(i) < 0 ? "-" : "")
+      << std::abs(v(i)) << " " << names[i];
+    first = false;
+  }
+  return s.str();
+}
+
+}  // namespace
+
+namespace detail {
+
+ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, FitModel model,
+               const materials::TabulatedProfile* table, double eta0, bool relative,
+               const std::array<double, 3>& exclude, const std::array<StartValues, 3>& start,
+               std::array<bool, 3> channels, int* below_noise,
+               ModelPerturbation perturbation) {
+  const QualitySettings q = quality_settings(options.quality);
+  const GaussLegendre gl = detail::gauss_legendre(q.footprint_order);
+  Problem p;
+  p.eta = eta0;
+  p.log_scale = relative ? start[0].log_scale : 0.0;
+  for (int c = 0; c < 3; ++c) {
+    p.ab[c] = {std::log(start[c].sigma_a), std::log(start[c].sigma_s_reduced)};
+  }
+  ceres::Problem problem;
+  std::array<int, 3> samples{};
+  std::array<double, 3> range_end{};
+  std::vector<std::pair<int, int>> block_channels;  // (channel, residuals) in insertion order
+  std::vector<std::pair<double*, std::string>> calibration_blocks;
+  for (std::size_t di = 0; di < data.size(); ++di) {
+    const ProfileData& d = data[di];
+    const bool use_2d = d.samples_2d.has_value() && d.incidence_polar_deg > 0;
+    p.calibration.push_back({0.0, 0.0, 0.0});
+    for (int c = 0; c < 3; ++c) {
+      if (!channels[c] || !d.channels[c]) continue;
+      p.observations.push_back(observations_for(d, c, exclude[c], use_2d, q, below_noise));
+      Observations& o = p.observations.back();
+      if (o.log_value.empty()) continue;
+      for (std::size_t i = 0; i < o.log_value.size(); ++i)
+        range_end[c] = std::max(range_end[c], o.radial ? o.r[i] : std::hypot(o.x[i], o.y[i]));
+      if (model == FitModel::kTabulated) {
+        // The table's own Monte Carlo error joins the data's in each weight (at the start
+        // values: the weights stay fixed during the solve).
+        const double st = start[c].sigma_a + start[c].sigma_s_reduced;
+        const double alpha = start[c].sigma_s_reduced / st;
+        for (std::size_t i = 0; i < o.log_value.size(); ++i) {
+          const double r = o.radial ? o.r[i] : std::hypot(o.x[i], o.y[i]);
+          const double t = table->relative_se(detail::table_quantity(o.geometry), r * st, alpha, eta0);
+          const double d2 = o.data_rel_se[i] * o.data_rel_se[i];
+          o.inv_rel_se[i] = std::isfinite(t) ? 1.0 / std::sqrt(d2 + t * t) : 1e-3 / std::sqrt(d2);
+        }
+      }
+      samples[c] += int(o.log_value.size());
+      // The scale this capture's channel is known to: exact (held), fitted freely (relative), or
+      // within the calibration's uncertainty (a prior).
+      double* scale = &p.log_scale;
+      const double cal_se = d.calibrated && !relative ? d.calibration_relative_se[c] : 0.0;
+      if (cal_se > 0) {
+        scale = &p.calibration.back()[c];
+        problem.AddResidualBlock(
+            new ceres::AutoDiffCostFunction<ScalePrior, 1, 1>(new ScalePrior{1.0 / cal_se}),
+            nullptr, scale);
+        block_channels.emplace_back(-1, 1);  // the prior's residual: not a sample
+        calibration_blocks.emplace_back(
+            scale, std::string("log calibration[") + kChannelNames[c] +
+                       (data.size() > 1 ? ", input " + std::to_string(di + 1) : "") + "]");
+      }
+      const bool scale_free = scale != &p.log_scale || relative;
+      if (options.loss == LossKind::kNone && !options.fit_ior && options.analytic_derivatives &&
+          model == FitModel::kDipole) {
+        problem.AddResidualBlock(new DipoleRadialCost(&o, gl, &p.eta), nullptr, p.ab[c].data(),
+                                 scale);
+        block_channels.emplace_back(c, int(o.log_value.size()));
+      } else if (options.loss == LossKind::kNone && !options.fit_ior && !scale_free) {
+        auto* cost = new ceres::AutoDiffCostFunction<ChannelResiduals, ceres::DYNAMIC, 2>(
+            new ChannelResiduals{{&o, model, gl, table, perturbation}, scale, &p.eta}, int(o.log_value.size()));
+        problem.AddResidualBlock(cost, nullptr, p.ab[c].data());
+        block_channels.emplace_back(c, int(o.log_value.size()));
+      } else if (options.loss == LossKind::kNone) {
+        auto* cost = new ceres::AutoDiffCostFunction<ProfileResiduals, ceres::DYNAMIC, 2, 1, 1>(
+            new ProfileResiduals{&o, model, gl, table, perturbation}, int(o.log_value.size()));
+        problem.AddResidualBlock(cost, nullptr, p.ab[c].data(), scale, &p.eta);
+        block_channels.emplace_back(c, int(o.log_value.size()));
+      } else {
+        // A robust loss acts on each sample, so each gets its own block.
+        for (std::size_t i = 0; i < o.log_value.size(); ++i) {
+          p.observations.push_back(o);
+          Observations& one = p.observations.back();
+          const auto pick = [&](std::vector<double>& v) {
+            if (!v.empty()) v = {v[i]};
+          };
+          pick(one.r);
+          pick(one.r0);
+          pick(one.r1);
+          pick(one.x);
+          pick(one.y);
+          pick(one.log_value);
+          pick(one.inv_rel_se);
+          pick(one.data_rel_se);
+          auto* cost = new ceres::AutoDiffCostFunction<ProfileResiduals, ceres::DYNAMIC, 2, 1, 1>(
+              new ProfileResiduals{&one, model, gl, table, perturbation}, 1);
+          ceres::LossFunction* loss =
+              options.loss == LossKind::kHuber
+                  ? static_cast<ceres::LossFunction*>(new ceres::HuberLoss(options.loss_scale))
+                  : new ceres::CauchyLoss(options.loss_scale);
+          problem.AddResidualBlock(cost, loss, p.ab[c].data(), scale, &p.eta);
+          block_channels.emplace_back(c, 1);
+        }
+      }
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    if (channels[c] && samples[c] < 2) {
+      throw Error(std::string("fit: channel ") + kChannelNames[c] + " has " +
+                  std::to_string(samples[c]) + " usable samples outside the exclusion radius (" +
+                  std::to_string(exclude[c]) +
+                  " mm) and above the noise floor; at least 2 are needed for sigma_a and sigma_s'");
+    }
+  }
+  if (problem.HasParameterBlock(&p.log_scale) && !relative)
+    problem.SetParameterBlockConstant(&p.log_scale);
+  if (problem.HasParameterBlock(&p.eta)) {
+    if (!options.fit_ior)
+      problem.SetParameterBlockConstant(&p.eta);
+    else if (model == FitModel::kTabulated)
+      problem.SetParameterLowerBound(&p.eta, 0, table->eta_min()),
+          problem.SetParameterUpperBound(&p.eta, 0, table->eta_max());
+    else
+      problem.SetParameterLowerBound(&p.eta, 0, 1.0001),
+          problem.SetParameterUpperBound(&p.eta, 0, 2.5);
+  }
+
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;  // 6 parameters: normal equations are tiny
+  so.function_tolerance = q.function_tolerance;
+  so.parameter_tolerance = q.parameter_tolerance;
+  so.gradient_tolerance = 1e-14;
+  so.max_num_iterations = options.max_iterations > 0 ? options.max_iterations : q.max_iterations;
+  so.logging_type = ceres::SILENT;
+  so.num_threads = 1;
+
+  ModelFit fit;
+  fit.model = model;
+  const auto t0 = std::chrono::steady_clock::now();
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+
+  // Which parameters are free, and is the problem well posed at the solution?
+  std::vector<double*> blocks;
+  std::vector<std::string> names;
+  for (int c = 0; c < 3; ++c) {
+    if (!channels[c]) continue;
+    blocks.push_back(p.ab[c].data());
+    names.push_back(std::string("log sigma_a[") + kChannelNames[c] + "]");
+    names.push_back(std::string("log sigma_s'[") + kChannelNames[c] + "]");
+  }
+  if (relative) blocks.push_back(&p.log_scale), names.push_back("log scale");
+  if (options.fit_ior) blocks.push_back(&p.eta), names.push_back("eta");
+  for (const auto& [block, name] : calibration_blocks)
+    blocks.push_back(block), names.push_back(name);
+
+  ceres::Problem::EvaluateOptions eo;
+  eo.parameter_blocks = blocks;
+  ceres::CRSMatrix crs;
+  std::vector<double> residuals;  // in residual-block order, for the per-channel statistics below
+  problem.Evaluate(eo, nullptr, &residuals, nullptr, &crs);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int row = 0; row < crs.num_rows; ++row) {
+    for (int k = crs.rows[row]; k < crs.rows[row + 1]; ++k) J(row, crs.cols[k]) = crs.values[k];
+  }
+  Eigen::MatrixXd covariance;
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeThinV);
+  const Eigen::VectorXd sv = svd.singularValues();
+  const double smax = sv.size() ? sv(0) : 0;
+  Eigen::VectorXd inv2 = Eigen::VectorXd::Zero(sv.size());
+  for (int i = 0; i < sv.size(); ++i) {
+    // A direction is undetermined when the data cannot pin it within a factor e (its standard
+    // deviation in log space, 1 / s, exceeds 1), or when it is numerically null.
+    if (sv(i) > 1e-10 * smax && sv(i) > 1.0) {
+      inv2(i) = 1.0 / (sv(i) * sv(i));
+    } else {
+      fit.undetermined.push_back(describe_combination(svd.matrixV().col(i), names));
+    }
+  }
+  // A parameter that leans on an undetermined direction is known to no better than a factor e:
+  // its log-space variance is at least 1 (reported, never a deceptive 0).
+  std::vector<double> floor_var(std::size_t(sv.size() ? svd.matrixV().rows() : 0), 0.0);
+  for (int i = 0; i < sv.size(); ++i) {
+    if (inv2(i) != 0) continue;
+    for (int j = 0; j < svd.matrixV().rows(); ++j)
+      if (std::abs(svd.matrixV()(j, i)) > 0.3) floor_var[std::size_t(j)] = 1.0;
+  }
+  // (J^T J)^+ from the SVD: the covariance of the free parameters when the standard errors are
+  // honest; directions the data does not determine are left out and reported instead.
+  covariance = svd.matrixV() * inv2.asDiagonal() * svd.matrixV().transpose();
+  fit.time_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+
+  fit.converged = summary.termination_type == ceres::CONVERGENCE;
+  fit.iterations = int(summary.iterations.size()) - 1;
+  fit.message = summary.message;
+  fit.chi2 = 2 * summary.final_cost;
+  fit.eta = p.eta;
+  fit.scale = std::exp(p.log_scale);
+  for (int c = 0; c < 3; ++c) fit.calibration_scale[c] = std::exp(p.calibration.front()[c]);
+  int k = 0;
+  for (int c = 0; c < 3; ++c) {
+    ChannelFit& ch = fit.channels[c];
+    ch.start_sigma_a = start[c].sigma_a;
+    ch.start_sigma_s_reduced = start[c].sigma_s_reduced;
+    if (!channels[c]) continue;
+    ch.sigma_a = std::exp(p.ab[c][0]);
+    ch.sigma_s_reduced = std::exp(p.ab[c][1]);
+    const double va = std::max(covariance(k, k), floor_var[std::size_t(k)]);
+    const double vs = std::max(covariance(k + 1, k + 1), floor_var[std::size_t(k) + 1]);
+    ch.sd_sigma_a = ch.sigma_a * std::sqrt(std::max(0.0, va));  // delta method from log space
+    ch.sd_sigma_s_reduced = ch.sigma_s_reduced * std::sqrt(std::max(0.0, vs));
+    if (floor_var[std::size_t(k)] > 0 && range_end[c] > 0) {
+      // An undetermined sigma_a may have run to ~0: bound it instead by the absorption a profile
+      // of this reach would just show, sigma_tr R = 1, i.e. sigma_a = 1 / (3 sigma_t' R^2).
+      const double st = ch.sigma_a + ch.sigma_s_reduced;
+      ch.sd_sigma_a = std::max(ch.sd_sigma_a, 1.0 / (3 * st * range_end[c] * range_end[c]));
+    }
+    ch.correlation = va > 0 && vs > 0 ? covariance(k, k + 1) / std::sqrt(va * vs) : 0.0;
+    ch.samples = samples[c];
+    k += 2;
+  }
+  if (relative) fit.sd_scale = fit.scale * std::sqrt(std::max(0.0, covariance(k, k))), ++k;
+  if (options.fit_ior) fit.sd_eta = std::sqrt(std::max(0.0, covariance(k, k))), ++k;
+  k += int(calibration_blocks.size());
+  fit.parameters = k;
+  // Per-channel chi^2 and rms from the residuals at the solution.
+  {
+    std::size_t offset = 0;
+    std::array<double, 3> chi2{};
+    for (const auto& [c, count] : block_channels) {
+      for (int i = 0; i < count; ++i, ++offset) {
+        if (c >= 0) chi2[c] += residuals[offset] * residuals[offset];
+      }
+    }
+    // fit.chi2 (AIC, BIC) keeps the calibration priors' share: a model that reaches the data only
+    // by rescaling the calibration far beyond its uncertainty pays for it.
+    for (int c = 0; c < 3; ++c) {
+      ChannelFit& ch = fit.channels[c];
+      ch.chi2 = chi2[c];
+      ch.residual_rms = samples[c] ? std::sqrt(chi2[c] / samples[c]) : 0.0;
+      // Lack of fit: a reduced chi^2 above 1 says the residuals are larger than the standard
+      // errors allow, so the statistical spread is that much larger (Birge ratio).
+      ch.reduced_chi2 = samples[c] > 2 ? chi2[c] / (samples[c] - 2) : 0.0;
+      const double birge = std::sqrt(std::max(1.0, ch.reduced_chi2));
+      ch.sd_sigma_a *= birge;
+      ch.sd_sigma_s_reduced *= birge;
+      ch.sd_stat_sigma_a = ch.sd_sigma_a;
+      ch.sd_stat_sigma_s_reduced = ch.sd_sigma_s_reduced;
+      ch.exclude_radius_mm = exclude[c];
+    }
+  }
+  // The usable range of each channel: from its exclusion radius to its last fitted sample.
+  {
+    for (int c = 0; c < 3; ++c) fit.channels[c].range_end_mm = range_end[c];
+    for (ChannelFit& ch : fit.channels) {
+      const double sigma_tr = std::sqrt(3 * ch.sigma_a * (ch.sigma_a + ch.sigma_s_reduced));
+      ch.range_diffusion_lengths =
+          std::max(0.0, ch.range_end_mm - ch.exclude_radius_mm) * sigma_tr;
+    }
+  }
+  fit.samples = samples[0] + samples[1] + samples[2];
+  fit.aic = fit.chi2 + 2.0 * fit.parameters;
+  fit.bic = fit.chi2 + fit.parameters * std::log(std::max(1, fit.samples));
+  return fit;
+}
+
+
+}  // namespace detail
+
+}  // namespace lucent::fit
