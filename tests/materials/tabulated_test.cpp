@@ -218,6 +218,33 @@ TEST(TransportTableFile, MergeJoinsDisjointSlicesAndRefusesDuplicates) {
   EXPECT_THROW(merge_transport_tables({a, other_grid}), Error);
 }
 
+TEST(TabulatedModel, ShippedTableStaysFiniteAtEveryExtreme) {
+  // The stability sweep of the other models (stability_test.cpp), for the tabulated one with the
+  // shipped table: alpha' 1e-6 .. 1 - 1e-8, eta 1.0 .. 2.5 (clamped beyond the table's 1.6),
+  // 1e-6 .. 1e4 transport mean free paths, g 0 .. 0.9; values and their Jet derivatives finite.
+  using J = ceres::Jet<double, 2>;
+  for (double g : {0.0, 0.5, 0.85}) {
+    const auto profile = cached_tabulated_profile(default_transport_table(), g);
+    for (double one_minus : {1 - 1e-6, 0.5, 1e-2, 1e-4, 1e-6, 1e-8}) {
+      for (double eta : {1.0, 1.33, 1.6, 2.0, 2.5}) {
+        const double alpha = 1 - one_minus;
+        const Medium<J> m{J(1 - alpha, 0), J(alpha / (1 - g), 1), J(g), J(eta)};
+        const TabulatedModel<J> model(*profile, m);
+        for (double r = 1e-6; r < 2e4; r *= 10) {
+          for (TableQuantity q : {TableQuantity::kExitance, TableQuantity::kRadiance}) {
+            const J v = model.at(q, J(r));
+            EXPECT_TRUE(std::isfinite(v.a) && v.a >= 0) << alpha << " " << eta << " " << r;
+            EXPECT_TRUE(std::isfinite(v.v[0]) && std::isfinite(v.v[1]))
+                << alpha << " " << eta << " " << r;
+          }
+        }
+        const J total = model.total_diffuse_reflectance();
+        EXPECT_TRUE(std::isfinite(total.a) && total.a >= 0 && total.a < 1) << alpha << " " << eta;
+      }
+    }
+  }
+}
+
 TEST(TabulatedProfile, RefusesAGOutsideTheTable) {
   EXPECT_THROW(TabulatedProfile(synthetic_table(), 0.5), Error);
 }
