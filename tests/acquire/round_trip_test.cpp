@@ -21,6 +21,31 @@ fs::path fresh_dir(const std::string& name) {
   return dir;
 }
 
+// The truth binned exactly as acquire bins the measurement: the sum of the truth (and of the
+// squares of its standard error) over the pixels whose centres fall in bin b, and their number.
+struct BinnedTruth {
+  double sum = 0, se2 = 0;
+  int n = 0;
+};
+BinnedTruth bin_truth(const Profile& profile, std::size_t b, int c, const ImageRgb& truth,
+                      const ImageRgb* truth_se) {
+  BinnedTruth t;
+  const bool last = b + 1 == profile.radial.size();
+  for (int j = 0; j < truth.height; ++j) {
+    for (int i = 0; i < truth.width; ++i) {
+      const double r = 0.25 * std::hypot(i + 0.5 - profile.beam_point_px[0],
+                                         j + 0.5 - profile.beam_point_px[1]);
+      if (r >= profile.radial.r_inner_mm[b] &&
+          (r < profile.radial.r_outer_mm[b] || (last && r <= profile.radial.r_outer_mm[b]))) {
+        t.sum += truth.at(i, j, c);
+        if (truth_se) t.se2 += double(truth_se->at(i, j, c)) * truth_se->at(i, j, c);
+        ++t.n;
+      }
+    }
+  }
+  return t;
+}
+
 TEST(RoundTrip, SimulateThenAcquireRecoversTheRadianceInAbsoluteUnits) {
   const fs::path sim = fresh_dir("sim"), acq = fresh_dir("acq");
   SimulateOptions o;
@@ -47,20 +72,9 @@ TEST(RoundTrip, SimulateThenAcquireRecoversTheRadianceInAbsoluteUnits) {
   int bins = 0, within = 0;
   for (std::size_t b = 0; b < profile.radial.size(); ++b) {
     for (int c = 0; c < 3; ++c) {
-      double sum = 0;
-      int n = 0;
-      for (int j = 0; j < truth.height; ++j) {
-        for (int i = 0; i < truth.width; ++i) {
-          const double r = 0.25 * std::hypot(i + 0.5 - profile.beam_point_px[0],
-                                             j + 0.5 - profile.beam_point_px[1]);
-          const bool last = b + 1 == profile.radial.size();
-          if (r >= profile.radial.r_inner_mm[b] &&
-              (r < profile.radial.r_outer_mm[b] || (last && r <= profile.radial.r_outer_mm[b]))) {
-            sum += truth.at(i, j, c);
-            ++n;
-          }
-        }
-      }
+      const BinnedTruth t = bin_truth(profile, b, c, truth, nullptr);
+      const double sum = t.sum;
+      const int n = t.n;
       if (n != profile.radial.count[c][b])
         continue;  // a masked pixel changed the set: skip the bin
       const double expected = std::numbers::pi * sum / n;
@@ -102,21 +116,9 @@ TEST_P(ProfileWithoutBias, EveryBinAgreesWithTheTruthDownToTheNoise) {
   double worst = 0, tail_z = 0;
   for (std::size_t b = 0; b < profile.radial.size(); ++b) {
     for (int c = 0; c < 3; ++c) {
-      double sum = 0, se2 = 0;
-      int n = 0;
-      for (int j = 0; j < truth.height; ++j) {
-        for (int i = 0; i < truth.width; ++i) {
-          const double r = 0.25 * std::hypot(i + 0.5 - profile.beam_point_px[0],
-                                             j + 0.5 - profile.beam_point_px[1]);
-          const bool last = b + 1 == profile.radial.size();
-          if (r >= profile.radial.r_inner_mm[b] &&
-              (r < profile.radial.r_outer_mm[b] || (last && r <= profile.radial.r_outer_mm[b]))) {
-            sum += truth.at(i, j, c);
-            se2 += double(truth_se.at(i, j, c)) * truth_se.at(i, j, c);
-            ++n;
-          }
-        }
-      }
+      const BinnedTruth t = bin_truth(profile, b, c, truth, &truth_se);
+      const double sum = t.sum, se2 = t.se2;
+      const int n = t.n;
       if (n != profile.radial.count[c][b]) continue;  // a masked pixel changed the set
       const double expected = std::numbers::pi * sum / n;
       const double value = profile.radial.value[c][b];
