@@ -334,6 +334,27 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
             std::pow(f.channels[c].sigma_s_reduced - result.chosen.channels[c].sigma_s_reduced, 2);
       }
     }
+    // A sigma_a the data cannot see (below what their reach shows, sigma_tr R < 1) may sit near 0
+    // while the truth is anywhere up to that bound; sigma_s' moves with it. Refit with sigma_a held
+    // at the bound: the move of sigma_s' joins its systematic.
+    std::array<double, 3> held{};
+    bool any_held = false;
+    for (int c = 0; c < 3; ++c) {
+      const ChannelFit& ch = result.chosen.channels[c];
+      const double R = ch.range_end_mm, st_reduced = ch.sigma_a + ch.sigma_s_reduced;
+      if (!channels[c] || !(R > 0)) continue;
+      const double bound = 1.0 / (3 * st_reduced * R * R);
+      if (ch.sigma_a < 0.5 * bound) held[c] = bound, any_held = true;
+    }
+    if (any_held) {
+      const ModelFit f = solve(data, options, FitModel::kTabulated, tab, result.chosen.eta,
+                               relative, ex, st, channels, &ignored, ModelPerturbation{}, &held);
+      for (int c = 0; c < 3; ++c)
+        if (held[c] > 0)
+          shift2[c][1] += std::pow(f.channels[c].sigma_s_reduced -
+                                       result.chosen.channels[c].sigma_s_reduced,
+                                   2);
+    }
     const auto var = [&](double sum, double sum2) {
       return std::max(0.0, (sum2 - sum * sum / kBootstrap) / (kBootstrap - 1));
     };

@@ -347,7 +347,7 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
                const materials::TabulatedProfile* table, double eta0, bool relative,
                const std::array<double, 3>& exclude, const std::array<StartValues, 3>& start,
                std::array<bool, 3> channels, int* below_noise,
-               ModelPerturbation perturbation) {
+               ModelPerturbation perturbation, const std::array<double, 3>* hold_sigma_a) {
   const QualitySettings q = quality_settings(options.quality);
   const GaussLegendre gl = detail::gauss_legendre(q.footprint_order);
   Problem p;
@@ -450,6 +450,14 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
                   std::to_string(exclude[c]) +
                   " mm) and above the noise floor; at least 2 are needed for sigma_a and sigma_s'");
     }
+  }
+  for (int c = 0; hold_sigma_a && c < 3; ++c) {
+    const double held = (*hold_sigma_a)[c];
+    if (!(held > 0) || !problem.HasParameterBlock(p.ab[c].data())) continue;
+    // Held (within 1e-9 in log space) by bounds, so the Jacobian keeps its columns.
+    p.ab[c][0] = std::log(held);
+    problem.SetParameterLowerBound(p.ab[c].data(), 0, p.ab[c][0] - 1e-9);
+    problem.SetParameterUpperBound(p.ab[c].data(), 0, p.ab[c][0] + 1e-9);
   }
   if (problem.HasParameterBlock(&p.log_scale) && !relative)
     problem.SetParameterBlockConstant(&p.log_scale);

@@ -31,11 +31,13 @@ struct ModelPerturbation {
 };
 
 /// One solve of `model` from `start`, with each channel's exclusion radius; counts the samples
-/// left out below the noise floor into *below_noise.
+/// left out below the noise floor into *below_noise. hold_sigma_a: per channel a sigma_a (mm^-1)
+/// to hold fixed, or <= 0 for free.
 ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, FitModel model,
                const materials::TabulatedProfile* table, double eta0, bool relative,
                const std::array<double, 3>& exclude, const std::array<StartValues, 3>& start,
                std::array<bool, 3> channels, int* below_noise,
-               ModelPerturbation perturbation = {});
+               ModelPerturbation perturbation = {},
+               const std::array<double, 3>* hold_sigma_a = nullptr);
 
 }  // namespace lucent::fit::detail
