@@ -1,20 +1,14 @@
 #include "lucent/fit/fit.h"
 
 #include <ceres/ceres.h>
-#include <ceres/covariance.h>
 #include <glog/logging.h>
 
-#include <Eigen/Dense>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <deque>
-#include <numbers>
 #include <sstream>
 
 #include "fit_solve.h"
 #include "fit_start.h"
-#include "lucent/materials/albedo.h"
 #include "lucent/materials/tabulated.h"
 #include "lucent/materials/transport_table.h"
 #include "lucent/materials/error.h"
@@ -367,7 +361,7 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
       }
     }
   }
-  detail::finish_uncertainty(result, data, options, channels);
+  detail::finish_uncertainty(result, options, channels);
   if (tab_ok && options.systematics && result.chosen.model == FitModel::kTabulated) {
     detail::judge_adequacy(result, data, channels);
     // g: radial data cannot tell it from sigma_s; say how far the answer moves at the other end.

@@ -34,8 +34,8 @@ std::string number(double v, int precision = 3) {
 
 }  // namespace
 
-void finish_uncertainty(FitResult& result, const std::vector<ProfileData>& data,
-                        const FitOptions& options, const std::array<bool, 3>& channels) {
+void finish_uncertainty(FitResult& result, const FitOptions& options,
+                        const std::array<bool, 3>& channels) {
   const ModelFit* accurate = nullptr;
   for (const ModelFit& f : result.candidates)
     if (f.model == FitModel::kTabulated) accurate = &f;
@@ -104,7 +104,6 @@ void finish_uncertainty(FitResult& result, const std::vector<ProfileData>& data,
         if (candidate.model == f.model) candidate.undetermined.push_back("eta");
     }
   }
-  (void)data;
 }
 
 void judge_adequacy(FitResult& result, const std::vector<ProfileData>& data,

@@ -12,8 +12,8 @@ namespace lucent::fit::detail {
 
 /// Systematics of the diffusion candidates (their difference from the tabulated fit on the same
 /// data), totals, range warnings, an eta at the edge of its range named undetermined.
-void finish_uncertainty(FitResult& result, const std::vector<ProfileData>& data,
-                        const FitOptions& options, const std::array<bool, 3>& channels);
+void finish_uncertainty(FitResult& result, const FitOptions& options,
+                        const std::array<bool, 3>& channels);
 
 /// result.adequacy and result.adequate_model for a tabulated fit: the dipoles' profiles with the
 /// fitted coefficients against the table's, over the data's usable radii.

@@ -3,9 +3,6 @@
 #include <charconv>
 #include <cmath>
 #include <istream>
-#include <map>
-#include <memory>
-#include <mutex>
 #include <numbers>
 #include <sstream>
 

@@ -14,20 +14,6 @@
 namespace lucent::materials {
 namespace {
 
-// The row interpolant of log values p at x (ln rho), as TabulatedProfile::log_value has it:
-// Hermite inside, linear in x below the first centre, linear in rho beyond the last.
-double row_value(const std::vector<double>& x, const std::vector<double>& p, double lx) {
-  const std::size_t J = x.size();
-  if (lx > x.back()) {
-    const double slope = std::min(0.0, (p[J - 1] - p[J - 2]) / (x[J - 1] - x[J - 2]));
-    return p[J - 1] + slope * (std::exp(lx - x.back()) - 1);
-  }
-  const NodeWeights<double> w = hermite_weights(x, lx, true);
-  double sum = 0;
-  for (int k = 0; k < w.count; ++k) sum += w.w[std::size_t(k)] * p[std::size_t(w.first + k)];
-  return sum;
-}
-
 // Annulus averages -> point values at the bins' log centres. The file holds what Monte Carlo
 // measures, the mean over each annulus; the interpolant needs point values, and in a steep far
 // field (log value falling by ~sigma_tr rho, tens across a decade) the two differ by far more than
@@ -50,7 +36,7 @@ void to_point_values(std::vector<double>& f, const std::vector<double>& x,
       double avg = 0;
       for (int k = 0; k < 8; ++k) {
         const double r = std::sqrt(r0 * r0 + kNode[k] * (r1 * r1 - r0 * r0));
-        avg += kWeight[k] * std::exp(row_value(x, p, std::log(r)) - f[std::size_t(j)]);
+        avg += kWeight[k] * std::exp(interpolate_row(x, p, r) - f[std::size_t(j)]);
       }
       // Guard: an average that over- or underflows (a row that runs into the 1e-37 floor of the
       // file) leaves the value as it is.

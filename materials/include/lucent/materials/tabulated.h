@@ -142,6 +142,25 @@ NodeWeights<T> uniform_hermite_weights(double x0, double h, int n, const T& t) {
   return r;
 }
 
+/// A row of log values over uniform nodes x (ln rho of the bin centres) at rho: Hermite inside,
+/// linear in ln rho below the first centre, linear in rho beyond the last (falling only: beyond
+/// the table a profile cannot rise).
+template <typename T>
+T interpolate_row(const std::vector<double>& x, const std::vector<T>& row, const T& rho) {
+  using std::log;
+  const std::size_t J = x.size();
+  const T lr = log(rho);
+  if (lr > T(x.back())) {
+    T slope = (row[J - 1] - row[J - 2]) / T(x[J - 1] - x[J - 2]);
+    if (slope > T(0)) slope = T(0);
+    return row[J - 1] + slope * (rho / T(std::exp(x.back())) - T(1));
+  }
+  const NodeWeights<T> w = uniform_hermite_weights(x.front(), x[1] - x[0], int(J), lr);
+  T sum(0);
+  for (int c = 0; c < w.count; ++c) sum += w.w[std::size_t(c)] * row[std::size_t(w.first + c)];
+  return sum;
+}
+
 /// A transport table at one g, ready to evaluate: log(value / alpha') at the point centres of the
 /// radius bins (the annulus averages of the file turned into point values by a second-order
 /// correction), per eta slice.
@@ -172,35 +191,9 @@ class TabulatedProfile {
   /// value scales as alpha').
   template <typename T>
   T log_value(TableQuantity q, const T& rho, const T& u, const T& eta) const {
-    using std::log;
-    const NodeWeights<T> we = hermite_weights(eta_, eta, false);
-    const T uc = u < T(u_.back()) ? u : T(u_.back());
-    const NodeWeights<T> wu = hermite_weights(u_, uc, false);
-    const T lr = log(rho);
-    const auto at_x = [&](const NodeWeights<T>& wx) {
-      T sum(0);
-      for (int a = 0; a < we.count; ++a) {
-        const std::vector<double>& f = f_[std::size_t(we.first + a)][std::size_t(q)];
-        for (int b = 0; b < wu.count; ++b) {
-          const std::size_t row = std::size_t(wu.first + b) * std::size_t(J_);
-          T inner(0);
-          for (int c = 0; c < wx.count; ++c) inner += wx.w[c] * T(f[row + std::size_t(wx.first + c)]);
-          sum += we.w[a] * wu.w[b] * inner;
-        }
-      }
-      return sum;
-    };
-    if (lr > T(x_.back())) {
-      // Beyond the last bin: linear in rho (the far field falls as e^(-sigma_tr rho)).
-      NodeWeights<T> last, before;
-      last.first = J_ - 1, last.count = 1, last.w[0] = T(1);
-      before.first = J_ - 2, before.count = 1, before.w[0] = T(1);
-      const T f1 = at_x(last), f0 = at_x(before);
-      T slope = (f1 - f0) / T(x_[std::size_t(J_) - 1] - x_[std::size_t(J_) - 2]);
-      if (slope > T(0)) slope = T(0);  // beyond the table the profile can only fall
-      return f1 + slope * (rho / T(std::exp(x_.back())) - T(1));
-    }
-    return at_x(hermite_weights(x_, lr, true));
+    std::array<std::vector<T>, kTableQuantities> rows;
+    rows_at(u, eta, rows);
+    return row_log_value(rows[std::size_t(q)], rho);
   }
 
   /// The rows of log(value / alpha') over the bin centres at (u, eta), both quantities: what a
@@ -225,21 +218,10 @@ class TabulatedProfile {
     }
   }
 
-  /// A row from rows_at evaluated at rho, with log_value's rules beyond the ends.
+  /// A row from rows_at evaluated at rho (interpolate_row).
   template <typename T>
   T row_log_value(const std::vector<T>& row, const T& rho) const {
-    using std::log;
-    const T lr = log(rho);
-    if (lr > T(x_.back())) {
-      const std::size_t J = std::size_t(J_);
-      T slope = (row[J - 1] - row[J - 2]) / T(x_[J - 1] - x_[J - 2]);
-      if (slope > T(0)) slope = T(0);
-      return row[J - 1] + slope * (rho / T(std::exp(x_.back())) - T(1));
-    }
-    const NodeWeights<T> wx = uniform_hermite_weights(x_.front(), x_[1] - x_[0], J_, lr);
-    T sum(0);
-    for (int c = 0; c < wx.count; ++c) sum += wx.w[std::size_t(c)] * row[std::size_t(wx.first + c)];
-    return sum;
+    return interpolate_row(x_, row, rho);
   }
 
   /// value / sigma_t'^2 (exitance R, or pi L along the normal), per unit power entering.
