@@ -14,5 +14,6 @@ void register_bench_command(CLI::App& app);
 void register_render_command(CLI::App& app);
 void register_view_command(CLI::App& app);
 void register_tabulate_command(CLI::App& app);
+void register_compare_command(CLI::App& app);
 
 }  // namespace lucent::cli

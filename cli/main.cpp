@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   lucent::cli::register_render_command(app);
   lucent::cli::register_view_command(app);
   lucent::cli::register_tabulate_command(app);
+  lucent::cli::register_compare_command(app);
 
   try {
     app.parse(argc, argv);

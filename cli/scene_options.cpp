@@ -95,8 +95,16 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
   cmd->add_option("--exposure", args->settings.exposure,
                   "linear scale before the tone curve (PNG only; EXR stays linear)")
       ->capture_default_str();
+  cmd->add_option("--reference-sampling", args->reference_sampling,
+                  "reference: probes (points drawn from the profile around each pixel, found by "
+                  "probe rays; noise ~ 1/sqrt(--samples-pixel)) or area (--samples-reference "
+                  "uniform surface samples shared by all pixels)")
+      ->capture_default_str();
+  cmd->add_option("--samples-pixel", args->reference.pixel_samples,
+                  "reference (probes): probes per pixel per pass")
+      ->capture_default_str();
   cmd->add_option("--samples-reference", args->reference.surface_samples,
-                  "reference: surface samples per pass (uniform by area)")
+                  "reference (area): surface samples per pass (uniform by area)")
       ->capture_default_str();
   cmd->add_option("--passes", args->reference.passes,
                   "reference: progressive passes, each with new samples (image = their mean)")
@@ -115,7 +123,12 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
                   "maps: N, disc samples gathered per texel per frame (N <= M)")
       ->capture_default_str();
   cmd->add_option("--disc-points", args->settings.disc_points,
-                  "maps: M, exponentially biased Halton disc points")
+                  "maps: M, disc points (a quadrature of the disc around each texel)")
+      ->capture_default_str();
+  cmd->add_option("--disc-distribution", args->disc_distribution,
+                  "maps: profile (radii importance-sampled from the material's own profile, "
+                  "weights exact at any texel size) or exponential (seed 003: e^(-sigma* r), "
+                  "sigma* = min sigma_tr / q)")
       ->capture_default_str();
   cmd->add_option("--q", args->settings.q,
                   "maps: q, disc bias sigma* = min sigma_tr / q (q > 1 spreads the samples wider)")
@@ -153,6 +166,16 @@ SceneSetup build_scene(SceneArguments& args) {
   if (args.reference.surface_samples < 1) throw Error("--samples-reference: must be at least 1");
   if (args.reference.passes < 1) throw Error("--passes: must be at least 1");
   args.settings.disc_selection = parse_disc_selection(args.disc_selection);
+  args.settings.disc_distribution = parse_disc_distribution(args.disc_distribution);
+  if (args.reference_sampling == "probes") {
+    args.reference.sampling = ReferenceSampling::kProbes;
+  } else if (args.reference_sampling == "area") {
+    args.reference.sampling = ReferenceSampling::kArea;
+  } else {
+    throw Error("--reference-sampling: expected probes or area, got '" + args.reference_sampling +
+                "'");
+  }
+  if (args.reference.pixel_samples < 1) throw Error("--samples-pixel: must be at least 1");
   args.settings.validate();
   std::vector<Light> lights;
   for (const auto& text : args.lights) lights.push_back(parse_light(text));
@@ -168,7 +191,7 @@ SceneSetup build_scene(SceneArguments& args) {
   scene.material = materials::load_material(args.material);
   const std::string model_name =
       !args.model.empty() ? args.model : scene.material.diffusion_model("ddipole");
-  args.settings.model = materials::parse_diffusion_model(model_name, "--model");
+  args.settings.model = materials::parse_diffusion_model(model_name, "--model", true);
   scene.mesh = load_mesh(args.mesh, args.object_size_mm);
   scene.lights = lights;
   if (env) {

@@ -25,6 +25,8 @@ struct SceneArguments {
   std::string size;
   double object_size_mm = 100;
   std::string disc_selection = "strata";
+  std::string disc_distribution = "profile";
+  std::string reference_sampling = "probes";
   render::RenderSettings settings;
   render::ReferenceOptions reference;
 };

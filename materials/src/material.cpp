@@ -352,9 +352,7 @@ Material material_from_json(const nlohmann::json& doc, const std::string& source
 }
 
 std::string Material::diffusion_model(const std::string& fallback) const {
-  if (model == "dipole" || model == "ddipole") return model;
-  if (model == "tabulated")
-    return adequate_model == "dipole" || adequate_model == "ddipole" ? adequate_model : "ddipole";
+  if (model == "dipole" || model == "ddipole" || model == "tabulated") return model;
   return fallback;
 }
 

@@ -22,6 +22,7 @@ layout(early_fragment_tests) in;
 #include "random.glsl"
 #include "bssrdf_ddipole.glsl"
 #include "bssrdf_dipole.glsl"
+#include "bssrdf_tabulated.glsl"
 
 in vec3 g_position;  // x_o, mm
 in vec3 g_normal;
@@ -49,11 +50,16 @@ uniform vec4 u_light_position[LUCENT_MAX_LIGHTS];  // w = 0: xyz direction towar
 uniform vec3 u_light_radiance[LUCENT_MAX_LIGHTS];  // irradiance (directional) or intensity (point)
 uniform int u_light_sample_offset[LUCENT_MAX_LIGHTS];
 uniform int u_light_sample_count[LUCENT_MAX_LIGHTS];
+// A light-map texel's width at the surface, mm: x + y * (distance from the light), x for
+// directional lights (orthographic), y for point lights (perspective).
+uniform vec2 u_light_texel_mm[LUCENT_MAX_LIGHTS];
 
 uniform float u_rotation_offset;  // t / T
 uniform float u_eta;
 uniform DdipoleChannel u_ddipole[3];
 uniform DipoleChannel u_dipole[3];
+uniform TabulatedChannel u_tabulated[3];
+uniform sampler2D u_tabulated_rows;
 
 // Orthonormal basis around a unit vector (Duff et al. 2017, "Building an Orthonormal Basis,
 // Revisited").
@@ -68,6 +74,11 @@ void basis(vec3 n, out vec3 b1, out vec3 b2) {
 vec3 bssrdf(vec3 x_i, vec3 n_i, vec3 w_i, vec3 x_o, vec3 n_o) {
 #if defined(LUCENT_MODEL_DIPOLE)
   return dipole_S_d_rgb(u_dipole, distance(x_o, x_i));
+#elif defined(LUCENT_MODEL_TABULATED)
+  float r = distance(x_o, x_i);
+  return vec3(tabulated_S_d(u_tabulated_rows, u_tabulated[0], r),
+              tabulated_S_d(u_tabulated_rows, u_tabulated[1], r),
+              tabulated_S_d(u_tabulated_rows, u_tabulated[2], r));
 #else
   return ddipole_S_d_rgb(u_ddipole, x_i, n_i, w_i, x_o, n_o);
 #endif
@@ -106,8 +117,23 @@ void main() {
       ivec3 at = ivec3(ivec2(uv * light_map_size), l);
       vec4 p = texelFetch(u_light_positions, at, 0);
       if (p.w < 0.5) continue;  // no surface on this ray
-      vec3 x_i = p.xyz;
       vec3 n_i = texelFetch(u_light_normals, at, 0).xyz;
+      // The texel holds the surface point at its centre; the disc point's own ray (along w_d, or
+      // from the point light through x_d) meets the surface elsewhere in the texel. Intersecting
+      // that ray with the texel's tangent plane puts x_i where the sample's weight says it is,
+      // at any light-map resolution (texels larger than a mean free path otherwise move every
+      // near sample by up to half a texel, which biases the sum by the profile's curvature).
+      // Kept to a few texels along the ray, so grazing texels fall back to their centre.
+      vec3 origin = is_point ? light.xyz : x_d;
+      vec3 ray = is_point ? normalize(x_d - light.xyz) : -w_d;
+      float along = dot(n_i, ray);
+      vec3 x_i = p.xyz;
+      if (along < -0.05) {
+        float s = dot(p.xyz - origin, n_i) / along;
+        vec3 hit = origin + s * ray;
+        float texel = u_light_texel_mm[l].x + u_light_texel_mm[l].y * distance(origin, p.xyz);
+        if (distance(hit, p.xyz) <= 4.0 * texel) x_i = hit;
+      }
       vec3 w_i;
       vec3 E;
       if (is_point) {

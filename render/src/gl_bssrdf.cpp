@@ -1,7 +1,15 @@
 // Coefficient packing for the GLSL BSSRDF twins (see gl_bssrdf.h).
 #include "gl_bssrdf.h"
 
+#include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <string>
+
+#include "lucent/materials/error.h"
+#include "lucent/materials/fresnel.h"
+#include "lucent/materials/tabulated.h"
+#include "lucent/materials/transport_table.h"
 
 namespace lucent::render::gl {
 
@@ -15,6 +23,57 @@ DdipoleChannelData ddipole_channel_data(const materials::Medium<double>& medium)
 DipoleChannelData dipole_channel_data(const materials::Medium<double>& medium) {
   const auto c = materials::derive_coefficients(medium);
   return {float(c.alpha_prime), float(c.sigma_tr), float(c.z_r), float(c.z_v)};
+}
+
+TabulatedChannelData tabulated_channel_data(const materials::Medium<double>& medium, int row) {
+  const auto profile = materials::cached_tabulated_profile(materials::default_transport_table(),
+                                                           medium.g, medium.eta);
+  const std::vector<double>& x = profile->log_rho_nodes();
+  TabulatedChannelData d;
+  d.nodes = int(x.size());
+  d.row = row;
+  d.x0 = float(x.front());
+  d.h = float(x[1] - x[0]);
+  const double sigma_t = medium.sigma_a + medium.sigma_s * (1 - medium.g);
+  const double alpha = sigma_t > 0 ? medium.sigma_s * (1 - medium.g) / sigma_t : 0;
+  d.sigma_t = float(sigma_t);
+  d.log_values.assign(x.size(), 0.0f);
+  if (!(alpha > 0)) return d;  // scale 0: no subsurface light
+  std::array<std::vector<double>, materials::kTableQuantities> rows;
+  profile->rows_at(std::sqrt(std::max(0.0, 1 - alpha)), medium.eta, rows);
+  const auto& values = rows[std::size_t(materials::TableQuantity::kRadiance)];
+  for (std::size_t j = 0; j < x.size(); ++j) d.log_values[j] = float(values[j]);
+  d.scale = float(sigma_t * sigma_t * alpha /
+                  (std::numbers::pi * materials::fresnel_transmittance(1.0, medium.eta)));
+  return d;
+}
+
+void set_tabulated(GLuint program, const materials::Material& material, GLuint texture_unit,
+                   Texture& rows) {
+  std::array<TabulatedChannelData, 3> channels;
+  for (int c = 0; c < 3; ++c) channels[std::size_t(c)] = tabulated_channel_data(material.medium(c), c);
+  const int J = channels[0].nodes;
+  std::vector<float> texels(std::size_t(J) * 3, 0.0f);
+  for (int c = 0; c < 3; ++c) {
+    if (channels[std::size_t(c)].nodes != J) throw Error("tabulated model: channels' tables differ in size");
+    std::copy(channels[std::size_t(c)].log_values.begin(), channels[std::size_t(c)].log_values.end(),
+              texels.begin() + std::ptrdiff_t(c) * J);
+  }
+  rows = create_texture(GL_TEXTURE_2D);
+  glTextureStorage2D(rows.id(), 1, GL_R32F, J, 3);
+  glTextureSubImage2D(rows.id(), 0, 0, 0, J, 3, GL_RED, GL_FLOAT, texels.data());
+  glProgramUniform1i(program, glGetUniformLocation(program, "u_tabulated_rows"), GLint(texture_unit));
+  for (int c = 0; c < 3; ++c) {
+    const TabulatedChannelData& d = channels[std::size_t(c)];
+    const std::string n = "u_tabulated[" + std::to_string(c) + "].";
+    const auto loc = [&](const char* field) { return glGetUniformLocation(program, (n + field).c_str()); };
+    glProgramUniform1f(program, loc("sigma_t"), d.sigma_t);
+    glProgramUniform1f(program, loc("scale"), d.scale);
+    glProgramUniform1f(program, loc("x0"), d.x0);
+    glProgramUniform1f(program, loc("h"), d.h);
+    glProgramUniform1i(program, loc("nodes"), d.nodes);
+    glProgramUniform1i(program, loc("row"), d.row);
+  }
 }
 
 void set_bssrdf_uniforms(GLuint program, const materials::Material& material) {

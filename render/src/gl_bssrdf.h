@@ -4,8 +4,10 @@
 #pragma once
 
 #include <array>
+#include <vector>
 
 #include "gl_api.h"
+#include "gl_program.h"
 #include "lucent/materials/material.h"
 #include "lucent/materials/medium.h"
 
@@ -22,6 +24,23 @@ struct DipoleChannelData {
   float alpha_prime, sigma_tr, z_r, z_v;
 };
 static_assert(sizeof(DipoleChannelData) == 4 * sizeof(float));
+
+/// GLSL `TabulatedChannel` (bssrdf_tabulated.glsl), and its row of log values.
+struct TabulatedChannelData {
+  float sigma_t, scale, x0, h;
+  int nodes, row;
+  std::vector<float> log_values;  ///< nodes values: TabulatedProfile::rows_at, quantity radiance
+};
+
+/// The tabulated model of one channel at its (alpha', eta, g), from the default transport table;
+/// `row` is its row in the texture. Throws lucent::Error where the table does not reach the medium
+/// (g or eta outside it).
+TabulatedChannelData tabulated_channel_data(const materials::Medium<double>& medium, int row);
+
+/// A 2D texture of the material's three tabulated rows (R32F, nodes x 3), and the uniforms
+/// `u_tabulated[0..2]` of `program`.
+void set_tabulated(GLuint program, const materials::Material& material, GLuint texture_unit,
+                   Texture& rows);
 
 DdipoleChannelData ddipole_channel_data(const materials::Medium<double>& medium);
 DipoleChannelData dipole_channel_data(const materials::Medium<double>& medium);

@@ -23,7 +23,8 @@ namespace {
 
 constexpr int kMaxLights = 16;
 // Texture units.
-constexpr GLuint kUnitLightPositions = 0, kUnitLightNormals = 1, kUnitPrevious = 2;
+constexpr GLuint kUnitLightPositions = 0, kUnitLightNormals = 1, kUnitPrevious = 2,
+                 kUnitTabulated = 3;
 constexpr GLuint kUnitRadiance = 0, kUnitRadianceDepth = 1, kUnitEnvironment = 2;
 // Uniform-block bindings (as in the shaders).
 constexpr GLuint kLightMatricesBinding = 0, kLayerCamerasBinding = 1, kDiscSamplesBinding = 2;
@@ -130,6 +131,7 @@ struct RadianceMapRenderer::Impl {
   gl::Renderbuffer final_depth;
   gl::Framebuffer final_fbo;
   gl::Texture environment;
+  gl::Texture tabulated_rows;  // the tabulated model's three rows (bssrdf_tabulated.glsl)
   bool has_environment = false;
 
   std::vector<detail::LayerCamera> layer_cams, light_cams;
@@ -264,7 +266,9 @@ void RadianceMapRenderer::Impl::build_programs() {
       "LUCENT_MAX_LIGHTS " + std::to_string(kMaxLights),
       "LUCENT_MAX_DIRECTIONS " + std::to_string(K),
       "LUCENT_MAX_DISC_SAMPLES " + std::to_string(settings.samples),
-      settings.model == DiffusionModel::kDipole ? "LUCENT_MODEL_DIPOLE" : "LUCENT_MODEL_DDIPOLE"};
+      settings.model == DiffusionModel::kDipole      ? "LUCENT_MODEL_DIPOLE"
+      : settings.model == DiffusionModel::kTabulated ? "LUCENT_MODEL_TABULATED"
+                                                     : "LUCENT_MODEL_DDIPOLE"};
   light_map_program = gl::Program({{GL_VERTEX_SHADER, "layered_mesh.vert"},
                                    {GL_GEOMETRY_SHADER, "light_map.geom"},
                                    {GL_FRAGMENT_SHADER, "light_map.frag"}},
@@ -425,7 +429,7 @@ void RadianceMapRenderer::Impl::upload_lights() {
   light_cams.clear();
   std::vector<float> matrices(std::size_t(kMaxLights) * 16, 0.0f);
   std::vector<float> position(std::size_t(kMaxLights) * 4, 0.0f),
-      radiance_(std::size_t(kMaxLights) * 3, 0.0f);
+      radiance_(std::size_t(kMaxLights) * 3, 0.0f), texel(std::size_t(kMaxLights) * 2, 0.0f);
   for (int l = 0; l < L; ++l) {
     const Light& light = scene.lights[std::size_t(l)];
     if (light.type == LightType::kDirectional) {
@@ -442,6 +446,8 @@ void RadianceMapRenderer::Impl::upload_lights() {
     }
     for (int c = 0; c < 3; ++c) radiance_[std::size_t(l) * 3 + std::size_t(c)] = light.radiance[c];
     std::copy_n(light_cams.back().view_proj.data(), 16, &matrices[std::size_t(l) * 16]);
+    texel[std::size_t(l) * 2] = light_cams.back().extent_mm / float(settings.light_map_size);
+    texel[std::size_t(l) * 2 + 1] = light_cams.back().extent_per_mm / float(settings.light_map_size);
   }
   glNamedBufferSubData(light_matrices.id(), 0, GLsizeiptr(matrices.size() * sizeof(float)),
                        matrices.data());
@@ -451,6 +457,7 @@ void RadianceMapRenderer::Impl::upload_lights() {
                       position.data());
   glProgramUniform3fv(p, radiance_program.location("u_light_radiance"), kMaxLights,
                       radiance_.data());
+  glProgramUniform2fv(p, radiance_program.location("u_light_texel_mm"), kMaxLights, texel.data());
 
   upload_disc(1, true);
 }
@@ -462,9 +469,14 @@ void RadianceMapRenderer::Impl::upload_disc(int t, bool redraw) {
   // changed (upload_lights) or when every frame has new radii.
   if (redraw || options.new_radii_each_frame) {
     const double box = (scene.mesh.bounds_max() - scene.mesh.bounds_min()).norm();
-    disc_points = detail::exponential_disc_points(
-        settings.disc_points, detail::sigma_star(scene.material, settings.q), box,
-        options.new_radii_each_frame ? detail::frame_shift(t) : Eigen::Vector3d::Zero());
+    const Eigen::Vector3d shift =
+        options.new_radii_each_frame ? detail::frame_shift(t) : Eigen::Vector3d::Zero();
+    disc_points = settings.disc_distribution == DiscDistribution::kProfile
+                      ? detail::profile_disc_points(settings.disc_points, scene.material,
+                                                    settings.model, box, shift)
+                      : detail::exponential_disc_points(
+                            settings.disc_points, detail::sigma_star(scene.material, settings.q),
+                            box, shift);
   }
   disc = detail::select_disc_samples(disc_points, settings.samples, L, settings.disc_selection, t);
   std::vector<float> packed(std::size_t(settings.samples) * 4, 0.0f);
@@ -493,6 +505,9 @@ void RadianceMapRenderer::Impl::upload_disc(int t, bool redraw) {
 
 void RadianceMapRenderer::Impl::upload_material() {
   gl::set_bssrdf_uniforms(radiance_program.id(), scene.material);
+  if (settings.model == DiffusionModel::kTabulated) {
+    gl::set_tabulated(radiance_program.id(), scene.material, kUnitTabulated, tabulated_rows);
+  }
   glProgramUniform1f(final_program.id(), final_program.location("u_eta"),
                      float(scene.material.ior));
   // sigma* depends on the material: the disc is rebuilt with the lights.
@@ -584,6 +599,10 @@ void RadianceMapRenderer::Impl::render_radiance() {
   glBindSampler(kUnitLightNormals, nearest.id());
   glBindTextureUnit(kUnitPrevious, radiance[previous].id());
   glBindSampler(kUnitPrevious, nearest.id());
+  if (settings.model == DiffusionModel::kTabulated) {
+    glBindTextureUnit(kUnitTabulated, tabulated_rows.id());
+    glBindSampler(kUnitTabulated, nearest.id());
+  }
   glBindVertexArray(mesh_vao.id());
   glDrawElementsInstanced(GL_TRIANGLES, index_count, GL_UNSIGNED_INT, nullptr, K);
   glDepthMask(GL_TRUE);

@@ -5,12 +5,15 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <numbers>
 #include <sstream>
 
 #include <Eigen/Geometry>
 
 #include "lucent/materials/error.h"
+#include "lucent/materials/profile_table.h"
+#include "profile_sampling.h"
 
 namespace lucent::render::detail {
 
@@ -56,31 +59,82 @@ Eigen::Vector3d frame_shift(int t) {
   return s;
 }
 
+namespace {
+
+// Z(rho) = integral over the disc of radius rho of e^(-sigma* r) dA
+//        = 2 pi / sigma*^2 (1 - e^(-sigma* rho) (1 + sigma* rho)), pi rho^2 for sigma* = 0.
+double exponential_disc_integral(double sigma, double rho) {
+  if (!(sigma > 0)) return std::numbers::pi * rho * rho;
+  const double s = sigma * rho;
+  return 2 * std::numbers::pi / (sigma * sigma) * (-std::expm1(-s) - std::exp(-s) * s);
+}
+
+double wrap01(double v) { return v - std::floor(v); }
+
+// A step through 0..size-1 that visits every offset (coprime with size) and jumps about 0.618 of
+// the stratum each time, so that the first frames spread over each stratum instead of walking up
+// from its inner end.
+long stratum_step(long size) {
+  long step = std::max(1L, std::lround(0.6180339887 * double(size)));
+  while (std::gcd(step, size) != 1) ++step;
+  return step % std::max(size, 1L);
+}
+
+}  // namespace
+
 DiscPoints exponential_disc_points(int M, double sigma_star_per_mm, double disc_radius_mm,
                                   const Eigen::Vector3d& shift) {
   if (M < 1) throw Error("--disc-points: need M >= 1, got " + std::to_string(M));
   DiscPoints out;
+  out.distribution = DiscDistribution::kExponential;
   out.sigma_star_per_mm = sigma_star_per_mm;
   double R = disc_radius_mm;
   if (sigma_star_per_mm > 0) R = std::min(R, 30.0 / sigma_star_per_mm);
   out.disc_radius_mm = R;
   std::vector<DiscPoints::Point>& kept = out.points;
   kept.reserve(std::size_t(M));
+  const double Z = exponential_disc_integral(sigma_star_per_mm, R);
   for (unsigned n = 1; int(kept.size()) < M; ++n) {
-    const auto wrap = [](double v) { return v - std::floor(v); };
-    const double s = wrap(radical_inverse(n, 2) + shift[0]),
-                 t = wrap(radical_inverse(n, 3) + shift[1]),
-                 zeta = wrap(radical_inverse(n, 5) + shift[2]);
+    const double s = wrap01(radical_inverse(n, 2) + shift[0]),
+                 t = wrap01(radical_inverse(n, 3) + shift[1]),
+                 zeta = wrap01(radical_inverse(n, 5) + shift[2]);
     const double r = R * std::sqrt(t);
     ++out.candidates;
     if (zeta < std::exp(-sigma_star_per_mm * r)) {
       const double phi = 2 * std::numbers::pi * s;
-      kept.push_back({r * std::cos(phi), r * std::sin(phi), r});
+      // The kept points are distributed as e^(-sigma* r) / Z(R) on the disc of radius R.
+      kept.push_back({r * std::cos(phi), r * std::sin(phi), r,
+                      Z * std::exp(sigma_star_per_mm * r) / M,
+                      exponential_disc_integral(sigma_star_per_mm, r) / Z});
     }
   }
   std::stable_sort(kept.begin(), kept.end(),
                    [](const DiscPoints::Point& a, const DiscPoints::Point& b) { return a.r < b.r; });
   return out;
+}
+
+DiscPoints profile_disc_points(int M, const materials::Material& material,
+                               materials::DiffusionModel model, double disc_radius_mm,
+                               const Eigen::Vector3d& shift) {
+  if (M < 1) throw Error("--disc-points: need M >= 1, got " + std::to_string(M));
+  const RadialProfileDensity density(material, model, disc_radius_mm);
+  if (!density.valid()) {
+    // Nothing scatters: no subsurface light; a uniform disc keeps the sums well defined (zero).
+    return exponential_disc_points(M, 0.0, disc_radius_mm, shift);
+  }
+  DiscPoints out;
+  out.distribution = DiscDistribution::kProfile;
+  out.disc_radius_mm = density.r_max();
+  out.candidates = M;
+  out.points.reserve(std::size_t(M));
+  const double s_radius = wrap01(0.5 + shift[0]), s_angle = wrap01(shift[1]);
+  for (int j = 0; j < M; ++j) {
+    double p_area = 0, cdf = 0;
+    const double r = density.sample((j + s_radius) / M, &p_area, &cdf);
+    const double phi = 2 * std::numbers::pi * wrap01(j * 0.6180339887498949 + s_angle);
+    out.points.push_back({r * std::cos(phi), r * std::sin(phi), r, 1.0 / (M * p_area), cdf});
+  }
+  return out;  // sorted by radius: the quantile increases with j
 }
 
 DiscSamples select_disc_samples(const DiscPoints& disc, int N, int lights, DiscSelection selection,
@@ -95,18 +149,20 @@ DiscSamples select_disc_samples(const DiscPoints& disc, int N, int lights, DiscS
   out.sigma_star_per_mm = disc.sigma_star_per_mm;
   out.disc_radius_mm = disc.disc_radius_mm;
   out.candidates = disc.candidates;
-  const double R = disc.disc_radius_mm, sigma_star_per_mm = disc.sigma_star_per_mm;
   const std::vector<DiscPoints::Point>& kept = disc.points;
   const bool strata = selection == DiscSelection::kStrata;
-  out.used_radius_mm =
-      N < M && !strata ? 0.5 * (kept[std::size_t(N) - 1].r + kept[std::size_t(N)].r) : R;
-  // Z(rho) = integral over the disc of radius rho of e^(-sigma* r) dA
-  //        = 2 pi / sigma*^2 (1 - e^(-sigma* rho) (1 + sigma* rho)), pi rho^2 for sigma* = 0.
-  const double sigma = sigma_star_per_mm, rho = out.used_radius_mm;
-  const double Z =
-      sigma > 0 ? 2 * std::numbers::pi / (sigma * sigma) * -std::expm1(-sigma * rho) -
-                      2 * std::numbers::pi / (sigma * sigma) * std::exp(-sigma * rho) * sigma * rho
-                : std::numbers::pi * rho * rho;
+  const bool shrink = N < M && !strata;
+  out.used_radius_mm = shrink ? 0.5 * (kept[std::size_t(N) - 1].r + kept[std::size_t(N)].r)
+                              : disc.disc_radius_mm;
+  // kNearest: the N nearest stand for the part of the sampling density below rho, F(rho) (the
+  // points below rho are distributed as the density restricted there).
+  double F = 1;
+  if (shrink) {
+    F = disc.distribution == DiscDistribution::kExponential
+            ? exponential_disc_integral(disc.sigma_star_per_mm, out.used_radius_mm) /
+                  exponential_disc_integral(disc.sigma_star_per_mm, disc.disc_radius_mm)
+            : 0.5 * (kept[std::size_t(N) - 1].cdf + kept[std::size_t(N)].cdf);
+  }
 
   // The N points of this frame and how many of the M each stands for.
   const int L = std::min(lights, N);
@@ -114,18 +170,20 @@ DiscSamples select_disc_samples(const DiscPoints& disc, int N, int lights, DiscS
   std::vector<std::pair<const DiscPoints::Point*, double>> chosen;
   for (int i = 0; i < N; ++i) {
     if (!strata) {
-      chosen.emplace_back(&kept[std::size_t(i)], 1.0);
+      chosen.emplace_back(&kept[std::size_t(i)], double(M) * F / N);
       continue;
     }
     // Stratum i goes to light (i + t) mod L, so that over L frames every light gathers every
-    // stratum; the point within the stratum advances every L frames.
+    // stratum; the point within the stratum advances every L frames, by a stride that visits
+    // each of its points once in `size` steps, starting from its middle.
     const long begin = long(i) * M / N, end = long(i + 1) * M / N;
     const long size = end - begin;
-    const long pick = begin + (t / L) % size;
-    chosen.emplace_back(&kept[std::size_t(pick)], double(size) * N / M);
+    const long pick = begin + (size / 2 + long(t / L) * stratum_step(size)) % size;
+    chosen.emplace_back(&kept[std::size_t(pick)], double(size));
   }
   // Light l takes every L-th of the radius-sorted points (round-robin: the same spread of radii
-  // for every light), in strata mode shifted by the frame.
+  // for every light), in strata mode shifted by the frame. Each of its n_l points stands for
+  // N / n_l of the frame's N.
   const int rotation = strata ? t % L : 0;
   for (int l = 0; l < lights; ++l) {
     out.light_offset.push_back(int(out.samples.size()));
@@ -135,7 +193,7 @@ DiscSamples select_disc_samples(const DiscPoints& disc, int N, int lights, DiscS
     for (int i = first; i < N; i += L) {
       const auto& [p, share] = chosen[std::size_t(i)];
       out.samples.push_back(
-          {float(p->x), float(p->y), float(Z * std::exp(sigma * p->r) * share / count)});
+          {float(p->x), float(p->y), float(p->weight_mm2 * share * N / count)});
     }
     out.light_count.push_back(int(out.samples.size()) - out.light_offset.back());
   }
@@ -207,6 +265,7 @@ LayerCamera fitted_perspective(const Vec3f& centre, float radius_mm, const Vec3f
       distance > 1.05f * r ? std::asin(r / distance) : 75.0f * std::numbers::pi_v<float> / 180.0f;
   c.near_mm = std::max(distance - r, 1e-3f * std::max(distance, r));
   c.far_mm = distance + r;
+  c.extent_per_mm = 2 * std::tan(half_angle);
   const Vec3f target = distance > 0 ? centre : Vec3f(eye - Vec3f::UnitZ());
   c.view_proj =
       perspective(2 * half_angle, 1.0f, c.near_mm, c.far_mm) * look_at(eye, target, Vec3f::UnitY());

@@ -50,13 +50,29 @@ struct DiscSamples {
 struct DiscPoints {
   struct Point {
     double x, y, r;  ///< mm
+    double weight_mm2 = 0;  ///< the point's share of the disc in the quadrature of all M, mm^2
+    double cdf = 0;         ///< fraction of the sampling density below r (for kNearest)
   };
   std::vector<Point> points;
   double sigma_star_per_mm = 0, disc_radius_mm = 0;
   long candidates = 0;
+  DiscDistribution distribution = DiscDistribution::kExponential;
 };
 DiscPoints exponential_disc_points(int M, double sigma_star_per_mm, double disc_radius_mm,
                                    const Eigen::Vector3d& shift = Eigen::Vector3d::Zero());
+/// The disc of DiscDistribution::kProfile: M radii at the stratified quantiles (j + s) / M of the
+/// mixture density p(r) = (1/3) sum_c 2 pi r R_c(r) / R_tot,c of the channels that scatter (R_c
+/// the model's normal-incidence radial profile, radial_profile_value, quantity radiance), on
+/// [r_lo, R] with R the smaller of disc_radius_mm and where every channel's tail beyond holds
+/// 1e-5 of it; angles 2 pi frac(j / phi + s'). (s, s') = (0.5, 0) shifted by `shift` modulo 1.
+/// Weights 1 / (M p_A(r)), p_A = p(r) / (2 pi r) the density per area: the M points are a
+/// quadrature of the disc integral of any function, exact in the limit, and for the profile
+/// itself a near-constant integrand. The density is piecewise constant in ln r on 4096 cells, so
+/// the weights are exactly the inverse of the density the radii were drawn from.
+DiscPoints profile_disc_points(int M, const materials::Material& material,
+                               materials::DiffusionModel model, double disc_radius_mm,
+                               const Eigen::Vector3d& shift = Eigen::Vector3d::Zero());
+
 /// This frame's N of the points and their weights (see exponential_disc_samples).
 DiscSamples select_disc_samples(const DiscPoints& disc, int N, int lights,
                                 DiscSelection selection = DiscSelection::kNearest, int frame = 1);
@@ -107,6 +123,7 @@ struct LayerCamera {
   Vec3f direction{0, 0, 1};  ///< unit, from the object toward the camera (orthographic) or light
   float near_mm = 0, far_mm = 0;
   float extent_mm = 0;  ///< orthographic: width of the view, mm
+  float extent_per_mm = 0;  ///< perspective: width of the view per mm of distance (2 tan half-angle)
 };
 
 /// Orthographic camera looking at `centre` from direction `toward_camera`, covering the sphere of

@@ -21,140 +21,12 @@
 #include "lucent/materials/error.h"
 #include "lucent/materials/fresnel.h"
 #include "lucent/render/environment.h"
+#include "reference_common.h"
 
 namespace lucent::render {
 namespace {
 
-using Vec3d = Eigen::Vector3d;
-using Clock = std::chrono::steady_clock;
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-// ---------------------------------------------------------------------------------------------
-// Threads: work items handed out in chunks from an atomic counter; results never depend on which
-// thread ran what.
-
-void parallel_for(std::size_t count, int threads, std::size_t chunk,
-                  const std::function<void(std::size_t, std::size_t)>& body,
-                  const std::function<void(std::size_t)>& on_progress = {}) {
-  std::atomic<std::size_t> next{0}, done{0};
-  std::exception_ptr failure;
-  std::mutex failure_mutex;
-  const auto work = [&](bool reporter) {
-    try {
-      for (;;) {
-        const std::size_t begin = next.fetch_add(chunk);
-        if (begin >= count) break;
-        const std::size_t end = std::min(count, begin + chunk);
-        body(begin, end);
-        const std::size_t total = done.fetch_add(end - begin) + (end - begin);
-        if (reporter && on_progress) on_progress(total);
-      }
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(failure_mutex);
-      if (!failure) failure = std::current_exception();
-      next = count;
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work, false);
-  work(true);
-  for (auto& thread : pool) thread.join();
-  if (failure) std::rethrow_exception(failure);
-}
-
-// Counter-based random numbers: sample k of pass p of seed s is the same whatever thread draws it.
-std::uint64_t mix(std::uint64_t z) {
-  z += 0x9E3779B97F4A7C15ull;
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
-}
-double uniform01(std::uint64_t key) {
-  return double(mix(key) >> 11) * 0x1.0p-53;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Embree scene of the mesh.
-
-class RayScene {
- public:
-  explicit RayScene(const Mesh& mesh) {
-    device_ = rtcNewDevice("verbose=0");
-    if (!device_) throw Error("reference renderer: cannot create an Embree device");
-    scene_ = rtcNewScene(device_);
-    RTCGeometry geometry = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vertices = static_cast<float*>(
-        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                3 * sizeof(float), mesh.positions.size()));
-    for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
-      for (int k = 0; k < 3; ++k) vertices[3 * i + k] = mesh.positions[i][k];
-    }
-    auto* indices = static_cast<unsigned*>(
-        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                3 * sizeof(unsigned), mesh.triangles.size()));
-    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-      for (int k = 0; k < 3; ++k) indices[3 * t + k] = mesh.triangles[t][k];
-    }
-    rtcCommitGeometry(geometry);
-    rtcAttachGeometry(scene_, geometry);
-    rtcReleaseGeometry(geometry);
-    rtcCommitScene(scene_);
-  }
-  ~RayScene() {
-    rtcReleaseScene(scene_);
-    rtcReleaseDevice(device_);
-  }
-  RayScene(const RayScene&) = delete;
-  RayScene& operator=(const RayScene&) = delete;
-
-  /// Nearest hit: triangle index and Embree's barycentrics (u, v) of vertices 1 and 2; false if
-  /// none.
-  bool intersect(const Vec3f& origin, const Vec3f& direction, unsigned& triangle, float& u,
-                 float& v) const {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    RTCRayHit rh{};
-    set_ray(rh.ray, origin, direction, kInf);
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(scene_, &context, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-    triangle = rh.hit.primID;
-    u = rh.hit.u;
-    v = rh.hit.v;
-    return true;
-  }
-
-  bool occluded(const Vec3f& origin, const Vec3f& direction, double max_distance) const {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    RTCRay ray{};
-    set_ray(ray, origin, direction, max_distance);
-    rtcOccluded1(scene_, &context, &ray);
-    return ray.tfar < 0;  // Embree sets tfar = -inf on a hit
-  }
-
- private:
-  static void set_ray(RTCRay& ray, const Vec3f& o, const Vec3f& d, double tfar) {
-    ray.org_x = o.x();
-    ray.org_y = o.y();
-    ray.org_z = o.z();
-    ray.dir_x = d.x();
-    ray.dir_y = d.y();
-    ray.dir_z = d.z();
-    ray.tnear = 0.0f;
-    ray.tfar = std::isinf(tfar) ? std::numeric_limits<float>::infinity() : float(tfar);
-    ray.mask = ~0u;
-    ray.flags = 0;
-    ray.time = 0.0f;
-  }
-
-  RTCDevice device_ = nullptr;
-  RTCScene scene_ = nullptr;
-};
+using namespace detail;
 
 // ---------------------------------------------------------------------------------------------
 // Irradiance records and their cluster hierarchy.
@@ -274,27 +146,6 @@ class ClusterTree {
   std::vector<ClusterNode> nodes_;
 };
 
-// ---------------------------------------------------------------------------------------------
-// The BSSRDF per channel, in double.
-
-class ChannelBssrdf {
- public:
-  ChannelBssrdf(const materials::Medium<double>& medium, DiffusionModel model)
-      : model_(model), dipole_(medium), ddipole_(medium) {}
-
-  /// S_d per mm^2 per sr without Fresnel; n_i and w_i are ignored by the standard dipole.
-  double operator()(const Vec3d& x_i, const Vec3d& n_i, const Vec3d& w_i, const Vec3d& x_o,
-                    const Vec3d& n_o) const {
-    if (model_ == DiffusionModel::kDipole) return dipole_.S_d((x_o - x_i).norm());
-    return ddipole_.S_d(x_i, n_i, w_i, x_o, n_o);
-  }
-
- private:
-  DiffusionModel model_;
-  materials::StandardDipole<double> dipole_;
-  materials::DirectionalDipole<double> ddipole_;
-};
-
 struct GatherCounters {
   std::uint64_t exact = 0;    ///< S_d evaluations for single samples (per channel)
   std::uint64_t cluster = 0;  ///< S_d evaluations at sigma points (per channel)
@@ -402,12 +253,6 @@ struct SurfaceSampler {
   std::vector<double> cdf_;
 };
 
-struct PixelHit {
-  Vec3f x_o, n_o;
-  double fresnel_out = 0;  ///< F_t(eta, n_o . w_o)
-  double fresnel_reflect = 0;
-  Vec3f reflected = Vec3f::Zero();
-};
 
 }  // namespace
 
@@ -479,6 +324,9 @@ ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
   if (camera.width <= 0 || camera.height <= 0) {
     throw Error("reference renderer: the image must be at least 1x1 pixels, got " +
                 std::to_string(camera.width) + "x" + std::to_string(camera.height));
+  }
+  if (options.pixel_samples < 1) {
+    throw Error("--samples-pixel: must be at least 1, got " + std::to_string(options.pixel_samples));
   }
   if (options.surface_samples < 1) {
     throw Error("--samples-reference: must be at least 1, got " +
@@ -572,7 +420,22 @@ ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
                             double(std::max<std::size_t>(object_pixels.size(), 1));
   std::mutex progress_mutex;
 
+  std::uint64_t probe_hits = 0;
   for (int pass = 0; pass < options.passes; ++pass) {
+    std::vector<std::array<double, 3>> accumulated(object_pixels.size(), {0, 0, 0});
+    if (options.sampling == ReferenceSampling::kProbes) {
+      const auto gather_start = Clock::now();
+      const double work_before = double(pass) * double(std::max<std::size_t>(object_pixels.size(), 1));
+      const double work_all =
+          double(options.passes) * double(std::max<std::size_t>(object_pixels.size(), 1));
+      probe_pass(scene, model, options, rays, hits, object_pixels, pass, threads, accumulated,
+                 probe_hits, [&](std::size_t done) {
+                   if (!options.progress) return;
+                   std::lock_guard<std::mutex> lock(progress_mutex);
+                   options.progress(std::min(1.0, (work_before + double(done)) / work_all));
+                 });
+      gather_ms += ms_since(gather_start);
+    } else {
     const auto sampling_start = Clock::now();
     // Samples: position, shading normal, geometric normal (for the shadow-ray offset).
     std::vector<Vec3f> xs(N), ns(N), gs(N);
@@ -588,7 +451,6 @@ ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
 
     // One light group at a time (its records, tree and gather), so that memory stays at one record
     // per sample however many lights an environment map brings.
-    std::vector<std::array<double, 3>> accumulated(object_pixels.size(), {0, 0, 0});
     for (std::size_t g = 0; g < groups; ++g) {
       // Irradiance records: E = (A/N) radiance cos V F_t.
       const auto records_start = Clock::now();
@@ -666,6 +528,7 @@ ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
       cluster_total += cluster;
       gather_ms += ms_since(gather_start);
     }
+    }
 
     // This pass's image, folded into the running mean.
     ImageRgb image = background;
@@ -698,6 +561,9 @@ ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
                    {"gather", gather_ms}};
   stats.total_ms = ms_since(start);
   stats.details = {{"model", materials::to_string(model)},
+                   {"sampling", options.sampling == ReferenceSampling::kProbes ? "probes" : "area"},
+                   {"pixel_samples_per_pass", options.pixel_samples},
+                   {"probe_hits", probe_hits},
                    {"surface_samples_per_pass", options.surface_samples},
                    {"passes", options.passes},
                    {"lights", scene.lights.size()},

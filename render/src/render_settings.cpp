@@ -37,7 +37,8 @@ void RenderSettings::validate() const {
 std::string RenderSettings::to_string() const {
   std::ostringstream s;
   s << "RenderSettings{model=" << materials::to_string(model) << ", T=" << frames
-    << ", K=" << directions << ", N=" << samples << ", M=" << disc_points << ", q=" << q
+    << ", K=" << directions << ", N=" << samples << ", M=" << disc_points << ", disc=" << render::to_string(disc_distribution) << "/"
+    << render::to_string(disc_selection) << ", q=" << q
     << ", W_s=" << radiance_map_size << ", W_l=" << light_map_size << ", exposure=" << exposure
     << "}";
   return s.str();
@@ -51,6 +52,17 @@ DiscSelection parse_disc_selection(const std::string& text) {
 
 std::string to_string(DiscSelection selection) {
   return selection == DiscSelection::kNearest ? "nearest" : "strata";
+}
+
+DiscDistribution parse_disc_distribution(const std::string& text) {
+  if (text == "profile") return DiscDistribution::kProfile;
+  if (text == "exponential") return DiscDistribution::kExponential;
+  throw Error("--disc-distribution: expected profile or exponential (seed 003), got '" + text +
+              "'");
+}
+
+std::string to_string(DiscDistribution distribution) {
+  return distribution == DiscDistribution::kProfile ? "profile" : "exponential";
 }
 
 nlohmann::json RenderStats::to_json() const {

@@ -546,7 +546,7 @@ void Viewer::set_parameter(const std::string& name, const std::string& value) {
     return rebuild_maps();  // the reference does not use the disc
   }
   if (name == "model") {
-    settings_.model = materials::parse_diffusion_model(value, "--script set model");
+    settings_.model = materials::parse_diffusion_model(value, "--script set model", true);
     pending_ = settings_;
     model_from_material_ = false;
     rebuild_maps();
@@ -590,7 +590,7 @@ void Viewer::load_material(const std::string& source) {
   message_ = "material: " + scene_.material.name;
   if (model_from_material_ && !scene_.material.model.empty()) {
     settings_.model = pending_.model =
-        materials::parse_diffusion_model(scene_.material.diffusion_model(), "material model");
+        materials::parse_diffusion_model(scene_.material.diffusion_model(), "material model", true);
   }
   glfwSetWindowTitle(window_,
                      ("lucent view - " + scene_.material.name + " on " + scene_.mesh.name).c_str());

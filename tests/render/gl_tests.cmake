@@ -7,6 +7,9 @@ lucent_add_test(glsl_twin_test
 lucent_add_test(radiance_maps_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/radiance_maps_test.cpp
   LIBS lucent::render lucent::materials OpenGL::OpenGL)
+lucent_add_test(slab_truth_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/slab_truth_test.cpp
+  LIBS lucent::render lucent::materials OpenGL::OpenGL)
 # White-box: both include headers from render/src (gl_program.h, gl_bssrdf.h,
 # radiance_maps_sampling.h).
 foreach(t glsl_twin_test radiance_maps_test)

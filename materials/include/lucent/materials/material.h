@@ -37,9 +37,9 @@ struct Material {
   /// One channel (0 = R, 1 = G, 2 = B) as a Medium; isotropic when only sigma_s' is known.
   Medium<double> medium(int channel) const;
 
-  /// The diffusion model a renderer without the tabulated model should use: the fitted one, or
-  /// for a tabulated fit the adequate diffusion model (ddipole when none is adequate), or
-  /// `fallback` for a material that was not fitted.
+  /// The model a renderer uses by default: the one the material was fitted with (dipole, ddipole
+  /// or tabulated), or `fallback` for a material that was not fitted. (adequate_model says which
+  /// faster dipole is within the data's noise, for a user who trades accuracy for speed.)
   std::string diffusion_model(const std::string& fallback = "ddipole") const;
 
   std::string to_string() const;

@@ -183,6 +183,8 @@ class TabulatedProfile {
   double u_max() const { return u_.back(); }
   double rho_min() const { return rho_min_; }
   double rho_max() const { return rho_max_; }
+  /// ln rho of the bin centres: the uniform nodes the rows of rows_at are given on.
+  const std::vector<double>& log_rho_nodes() const { return x_; }
   std::uint64_t photons() const { return photons_; }
   std::string to_string() const;
 

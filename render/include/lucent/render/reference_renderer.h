@@ -34,8 +34,22 @@
 
 namespace lucent::render {
 
+/// How the reference draws the points x_i it integrates over (--reference-sampling).
+enum class ReferenceSampling {
+  /// Probe rays importance-sampling the material's profile around each pixel (reference_probes.cpp,
+  /// the default): pixel_samples per pixel per pass, noise independent of the mesh's area.
+  kProbes,
+  /// surface_samples uniform by area over the whole mesh, shared by every pixel, with clusters.
+  kArea,
+};
+
 struct ReferenceOptions {
-  int surface_samples = 200000;  ///< N per pass, uniform by area, stratified over the area CDF
+  ReferenceSampling sampling = ReferenceSampling::kProbes;
+  /// kProbes: probes per pixel per pass. Noise falls as 1 / sqrt(samples); measured on this
+  /// project's 2-core machine, 64 px marble sphere (directional + point light, ddipole): relative
+  /// RMSE between two seeds 0.013 at 1024 (2.4 s), 0.009 at 2048 (4.9 s); dragon:4 0.024 at 1024.
+  int pixel_samples = 1024;
+  int surface_samples = 200000;  ///< kArea: N per pass, uniform by area, stratified over the area CDF
   int threads = 0;               ///< worker threads; 0 = all hardware threads
   std::uint64_t seed = 1;        ///< same seed, same image, for any number of threads
   int passes = 1;         ///< progressive: each pass draws N new samples; image = running mean

@@ -32,6 +32,21 @@ enum class DiscSelection {
   kStrata,
 };
 
+/// How the M disc points are distributed over radius (--disc-distribution).
+enum class DiscDistribution {
+  /// Importance sampling of the material's own normal-incidence radial profile (an extension,
+  /// lucent's default): radii by inverting the CDF of the three channels' mean of
+  /// 2 pi r R_c(r) / R_tot,c at M stratified quantiles, each weighted by the inverse of that
+  /// density. On a plane the disc sum is then a quadrature of the profile itself at any sigma*,
+  /// texel size or mean free path: the near field of short-mean-free-path channels (where most
+  /// of the light leaves) is sampled as densely as the far tail, which the exponential disc
+  /// starves (seed 003's e^(-sigma* r) with sigma* = sigma_tr / q puts ~1 of 1000 points
+  /// inside marble's mean free path).
+  kProfile,
+  /// Seed 003 §5.3.4.1: Halton points kept with probability e^(-sigma* r), sigma* = min sigma_tr / q.
+  kExponential,
+};
+
 /// Knobs of the directional-dipole (or standard-dipole) radiance-map technique (DESIGN §7.1, §8).
 struct RenderSettings {
   DiffusionModel model = DiffusionModel::kDirectionalDipole;  ///< BSSRDF the maps gather with
@@ -42,6 +57,7 @@ struct RenderSettings {
   int disc_points = 1000;  ///< M: exponentially biased Halton disc points (--disc-points), N <= M
   double q = 1.0;          ///< sigma* = min_c sigma_tr,c / q, the disc's bias (--q), > 0
   DiscSelection disc_selection = DiscSelection::kStrata;  ///< --disc-selection
+  DiscDistribution disc_distribution = DiscDistribution::kProfile;  ///< --disc-distribution
   int radiance_map_size = 512;  ///< W_s: radiance-map layer size in texels (--radiance-map)
   int light_map_size = 512;     ///< W_l: light-map size in texels (--light-map)
   float exposure = 1.0f;        ///< linear scale before the tone curve (--exposure); applied
@@ -55,6 +71,8 @@ struct RenderSettings {
 
 DiscSelection parse_disc_selection(const std::string& text);  ///< nearest | strata
 std::string to_string(DiscSelection selection);
+DiscDistribution parse_disc_distribution(const std::string& text);  ///< profile | exponential
+std::string to_string(DiscDistribution distribution);
 
 /// Timings and counts of one render, for `--stats FILE` (JSON "lucent-render-stats", version 1).
 struct RenderStats {

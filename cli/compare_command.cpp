@@ -1,0 +1,82 @@
+// `lucent compare`: how far a render is from a reference (relative RMSE, per-channel mean ratios)
+// over the pixels where the reference shows the object.
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "lucent/acquire/image_io.h"
+#include "lucent/materials/error.h"
+#include "lucent/render/image_compare.h"
+#include "lucent/render/tone_map.h"
+
+namespace lucent::cli {
+namespace {
+
+struct CompareArguments {
+  std::string image, reference;
+  bool json = false;
+  std::string difference;
+  float scale = 10;
+};
+
+void run_compare(const CompareArguments& args) {
+  const render::ImageRgb image = acquire::read_exr(args.image);
+  const render::ImageRgb reference = acquire::read_exr(args.reference);
+  const render::ImageDifference d =
+      render::compare_images(image, reference, render::nonzero_mask(reference));
+  if (!args.difference.empty()) {
+    // |image - reference| / the reference's mean, times --scale: a black image is no difference,
+    // white (tone-mapped 1) is `1 / scale` of the mean.
+    render::ImageRgb diff(image.width, image.height, 0.0f);
+    const auto mask = render::nonzero_mask(reference);
+    for (std::size_t p = 0; p < mask.size(); ++p) {
+      if (!mask[p]) continue;
+      for (int c = 0; c < 3; ++c) {
+        const std::size_t i = 3 * p + std::size_t(c);
+        diff.data[i] = float(std::abs(image.data[i] - reference.data[i]) / d.reference_mean);
+      }
+    }
+    render::ToneMapOptions tone;
+    tone.exposure = args.scale;
+    render::write_render_image(args.difference, diff, tone);
+  }
+  if (args.json) {
+    const nlohmann::json doc = {{"format", "lucent-image-difference"},
+                                {"version", 1},
+                                {"image", args.image},
+                                {"reference", args.reference},
+                                {"pixels", d.pixels},
+                                {"relative_rmse", d.relative_rmse},
+                                {"mean_ratio", d.mean_ratio},
+                                {"reference_mean", d.reference_mean}};
+    std::printf("%s\n", doc.dump(2).c_str());
+  } else {
+    std::printf("compare: %s\n", d.to_string().c_str());
+  }
+}
+
+}  // namespace
+
+void register_compare_command(CLI::App& app) {
+  auto args = std::make_shared<CompareArguments>();
+  CLI::App* cmd = app.add_subcommand(
+      "compare",
+      "How far a linear render (EXR) is from a reference render of the same size: relative RMSE "
+      "(RMSE over pixels and channels / the reference's mean) and per-channel mean ratios, over "
+      "the pixels where the reference is not black");
+  cmd->add_option("image", args->image, "the render to judge (.exr)")->required();
+  cmd->add_option("reference", args->reference, "the reference (.exr), e.g. --technique reference")
+      ->required();
+  cmd->add_flag("--json", args->json, "print a JSON summary (lucent-image-difference)");
+  cmd->add_option("--difference", args->difference,
+                  "also write |image - reference| / the reference's mean as an image (.png or .exr)");
+  cmd->add_option("--scale", args->scale, "--difference: multiplier before the tone curve")
+      ->capture_default_str();
+  cmd->callback([args] { run_compare(*args); });
+}
+
+}  // namespace lucent::cli

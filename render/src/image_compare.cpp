@@ -1,0 +1,61 @@
+// Image differences (image_compare.h).
+#include "lucent/render/image_compare.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "lucent/materials/error.h"
+
+namespace lucent::render {
+
+std::string ImageDifference::to_string() const {
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "relative RMSE %.4f over %zu pixels; mean ratio R %.4f G %.4f B %.4f", relative_rmse,
+                pixels, mean_ratio[0], mean_ratio[1], mean_ratio[2]);
+  return text;
+}
+
+std::vector<std::uint8_t> nonzero_mask(const ImageRgb& reference) {
+  std::vector<std::uint8_t> mask(std::size_t(reference.width) * reference.height, 0);
+  for (std::size_t p = 0; p < mask.size(); ++p) {
+    for (int c = 0; c < 3; ++c) mask[p] |= reference.data[3 * p + std::size_t(c)] != 0.0f;
+  }
+  return mask;
+}
+
+ImageDifference compare_images(const ImageRgb& image, const ImageRgb& reference,
+                               const std::vector<std::uint8_t>& mask) {
+  if (image.width != reference.width || image.height != reference.height) {
+    throw Error("compare: the images differ in size (" + std::to_string(image.width) + "x" +
+                std::to_string(image.height) + " against " + std::to_string(reference.width) +
+                "x" + std::to_string(reference.height) + ")");
+  }
+  if (mask.size() != std::size_t(image.width) * image.height) {
+    throw Error("compare: the mask does not match the images");
+  }
+  ImageDifference d;
+  std::array<double, 3> sum_image{}, sum_reference{};
+  double squared = 0;
+  for (std::size_t p = 0; p < mask.size(); ++p) {
+    if (!mask[p]) continue;
+    ++d.pixels;
+    for (int c = 0; c < 3; ++c) {
+      const double a = image.data[3 * p + std::size_t(c)], b = reference.data[3 * p + std::size_t(c)];
+      sum_image[std::size_t(c)] += a;
+      sum_reference[std::size_t(c)] += b;
+      squared += (a - b) * (a - b);
+    }
+  }
+  if (d.pixels == 0) throw Error("compare: no pixel of the reference shows the object");
+  d.reference_mean = (sum_reference[0] + sum_reference[1] + sum_reference[2]) / (3.0 * d.pixels);
+  d.relative_rmse = std::sqrt(squared / (3.0 * d.pixels)) / d.reference_mean;
+  for (int c = 0; c < 3; ++c) {
+    d.mean_ratio[std::size_t(c)] = sum_reference[std::size_t(c)] > 0
+                                       ? sum_image[std::size_t(c)] / sum_reference[std::size_t(c)]
+                                       : (sum_image[std::size_t(c)] > 0 ? INFINITY : 1.0);
+  }
+  return d;
+}
+
+}  // namespace lucent::render
