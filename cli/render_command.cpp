@@ -4,10 +4,12 @@
 // before rendering so that bad input fails fast and leaves no output file.
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "commands.h"
 #include "lucent/materials/atomic_file.h"
@@ -26,7 +28,14 @@ struct RenderArguments {
   SceneArguments scene;
   std::string output;
   std::string stats;
+  std::vector<int> snapshots;
 };
+
+// OUT.exr -> OUT.f<t>.exr (the snapshot of frame t, always linear EXR).
+std::string snapshot_path(const std::string& output, int frame) {
+  const std::size_t dot = output.rfind('.');
+  return output.substr(0, dot) + ".f" + std::to_string(frame) + ".exr";
+}
 
 void print_progress(double fraction) {
   std::fprintf(stderr, "\rrender: %3d%%", int(std::lround(100 * fraction)));
@@ -42,6 +51,13 @@ void run_render(RenderArguments& render_args) {
                 "': output must be .png (tone-mapped) or .exr (linear)");
   }
   Scene scene = build_scene(args).scene;
+  if (!args.default_rig.empty()) {
+    std::string rig;
+    for (const auto& light : args.default_rig) rig += " --light " + light;
+    std::fprintf(stderr, "render: no --light or --env: the default rig (key, fill, rim):%s\n",
+                 rig.c_str());
+  }
+  const auto start = std::chrono::steady_clock::now();
 
   const bool show_progress = ::isatty(STDERR_FILENO) != 0;
   ImageRgb image;
@@ -53,16 +69,40 @@ void run_render(RenderArguments& render_args) {
     image = std::move(result.image);
     stats = std::move(result.stats);
   } else {
-    image = render_radiance_maps(scene, args.settings, &stats);
+    RadianceMapOptions options;
+    for (int t : render_args.snapshots) {
+      if (t < 1 || t > args.settings.frames) {
+        throw Error("--snapshots: frames must be 1.." + std::to_string(args.settings.frames) +
+                    " (--frames), got " + std::to_string(t));
+      }
+    }
+    options.snapshot_frames = render_args.snapshots;
+    options.on_snapshot = [&](int t, const ImageRgb& snapshot) {
+      write_render_image(snapshot_path(render_args.output, t), snapshot, ToneMapOptions{});
+    };
+    image = render_radiance_maps(scene, args.settings, options, &stats, nullptr);
   }
 
   ToneMapOptions tone;
-  tone.exposure = args.settings.exposure;
+  tone.exposure = args.auto_exposure ? auto_exposure(image) : args.settings.exposure;
   write_render_image(render_args.output, image, tone,
                      {{"lucent:units", "radiance, W mm^-2 sr^-1 per unit light"},
                       {"lucent:material", scene.material.name},
                       {"lucent:mesh", scene.mesh.name},
                       {"lucent:technique", args.technique}});
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const bool png = render_args.output.size() >= 4 &&
+                   render_args.output.substr(render_args.output.size() - 4) != ".exr" &&
+                   render_args.output.substr(render_args.output.size() - 4) != ".EXR";
+  std::printf("render: wrote %s (%dx%d, %s, %s on %s, %s%s) in %.1f s\n", render_args.output.c_str(),
+              scene.camera.width, scene.camera.height,
+              args.technique == "maps" ? "radiance maps" : "CPU reference",
+              materials::to_string(args.settings.model).c_str(), scene.mesh.name.c_str(),
+              png ? "exposure " : "linear",
+              png ? (std::to_string(tone.exposure) + (args.auto_exposure ? " (auto)" : "")).c_str()
+                  : "",
+              seconds);
   if (!render_args.stats.empty()) {
     nlohmann::json doc = stats.to_json();
     doc["scene"] = {{"material", scene.material.name},
@@ -92,6 +132,10 @@ void register_render_command(CLI::App& app) {
   cmd->add_option("-o,--output", args->output,
                   "output image: .png (tone-mapped sRGB) or .exr (linear); written atomically")
       ->required();
+  cmd->add_option("--snapshots", args->snapshots,
+                  "maps: also write the linear image after these frames as OUT.f<t>.exr "
+                  "(e.g. --snapshots 1,4,16)")
+      ->delimiter(',');
   cmd->add_option("--stats", args->stats,
                   "write timings (per pass or phase, ms) and counts as JSON (lucent-render-stats)");
   cmd->callback([args] { run_render(*args); });

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
@@ -92,9 +94,22 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
   cmd->add_option("--size", args->size, size_help)->capture_default_str();
   cmd->add_option("--object-size-mm", args->object_size_mm, "bounding-box diagonal of the mesh, mm")
       ->capture_default_str();
-  cmd->add_option("--exposure", args->settings.exposure,
-                  "linear scale before the tone curve (PNG only; EXR stays linear)")
+  cmd->add_option("--exposure", args->exposure,
+                  "linear scale before the tone curve (PNG only; EXR stays linear), or auto: the "
+                  "95th percentile of the object's luminance to 2 (2/3 after the curve)")
       ->capture_default_str();
+  cmd->add_option("--roughness", args->roughness,
+                  "GGX width alpha of the surface's specular lobe for every light (0 = smooth: "
+                  "no highlight from point or directional lights, only the environment's "
+                  "mirror image)")
+      ->capture_default_str();
+  cmd->add_option("--specular", args->specular,
+                  "on or off: the lights' specular lobe (off: the subsurface term alone, for "
+                  "comparing techniques)")
+      ->capture_default_str();
+  cmd->add_option("--backdrop", args->backdrop,
+                  "R,G,B: radiance of the background where there is no environment map "
+                  "(default black)");
   cmd->add_option("--reference-sampling", args->reference_sampling,
                   "reference: probes (points drawn from the profile around each pixel, found by "
                   "probe rays; noise ~ 1/sqrt(--samples-pixel)) or area (--samples-reference "
@@ -177,14 +192,49 @@ SceneSetup build_scene(SceneArguments& args) {
   }
   if (args.reference.pixel_samples < 1) throw Error("--samples-pixel: must be at least 1");
   args.settings.validate();
+  if (args.exposure == "auto") {
+    args.auto_exposure = true;
+    args.settings.exposure = 1.0f;
+  } else {
+    const auto e = parse_numbers(args.exposure, "--exposure", 1, ',', "a positive number or auto");
+    if (!(e[0] > 0)) throw Error("--exposure: must be positive or auto, got '" + args.exposure + "'");
+    args.auto_exposure = false;
+    args.settings.exposure = float(e[0]);
+  }
+  if (!(args.roughness >= 0) || !(args.roughness <= 1)) {
+    throw Error("--roughness: the GGX width must be 0..1, got " + std::to_string(args.roughness));
+  }
+  if (args.specular != "on" && args.specular != "off") {
+    throw Error("--specular: expected on or off, got '" + args.specular + "'");
+  }
+  Vec3f backdrop = Vec3f::Zero();
+  if (!args.backdrop.empty()) {
+    const auto b = parse_numbers(args.backdrop, "--backdrop", 3, ',', "R,G,B radiance >= 0");
+    if (b[0] < 0 || b[1] < 0 || b[2] < 0) {
+      throw Error("--backdrop: expected R,G,B radiance >= 0, got '" + args.backdrop + "'");
+    }
+    backdrop = Vec3f(float(b[0]), float(b[1]), float(b[2]));
+  }
   std::vector<Light> lights;
   for (const auto& text : args.lights) lights.push_back(parse_light(text));
   std::optional<EnvironmentArgument> env;
   if (!args.env.empty()) env = parse_environment_argument(args.env);
+  args.default_rig.clear();
   if (lights.empty() && !env) {
-    throw Error(
-        "no light: give --light directional:DX,DY,DZ:R,G,B, --light point:X,Y,Z:R,G,B or "
-        "--env FILE[:L]");
+    // The default rig, turned with the camera's azimuth so that it lights the object alike from
+    // every --view: a key light above the camera's left, a dim fill from its right and a rim light
+    // from behind (where a translucent object glows).
+    const double a = view[0] * std::numbers::pi / 180.0;
+    const auto turned = [a](double x, double y, double z) {
+      char text[96];
+      std::snprintf(text, sizeof text, "%.3g,%.3g,%.3g", std::cos(a) * x + std::sin(a) * z, y,
+                    -std::sin(a) * x + std::cos(a) * z);
+      return std::string(text);
+    };
+    args.default_rig = {"directional:" + turned(-1, 1, 1) + ":1,1,1",
+                        "directional:" + turned(1, 0.3, 0.5) + ":0.3,0.3,0.3",
+                        "directional:" + turned(0.3, 0.6, -1) + ":0.6,0.6,0.6"};
+    for (const auto& text : args.default_rig) lights.push_back(parse_light(text));
   }
 
   Scene scene;
@@ -203,6 +253,9 @@ SceneSetup build_scene(SceneArguments& args) {
     scene.lights.insert(scene.lights.end(), env_lights.begin(), env_lights.end());
     scene.environment = env->path;
   }
+  scene.roughness = args.roughness;
+  scene.specular = args.specular == "on";
+  scene.backdrop = backdrop;
   scene.camera = orbit_camera(scene.mesh, float(view[0]), float(view[1]), float(view[2]),
                               int(size[0]), int(size[1]));
   return SceneSetup{std::move(scene), float(view[0]), float(view[1]), float(view[2])};

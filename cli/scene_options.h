@@ -27,6 +27,12 @@ struct SceneArguments {
   std::string disc_selection = "strata";
   std::string disc_distribution = "profile";
   std::string reference_sampling = "probes";
+  std::string exposure = "auto";  ///< a number or auto (tone_map.h auto_exposure)
+  bool auto_exposure = true;      ///< set by build_scene from `exposure`
+  float roughness = 0.1f;
+  std::string specular = "on";
+  std::string backdrop;           ///< R,G,B radiance; empty: black
+  std::vector<std::string> default_rig;  ///< set by build_scene: the lights used when none given
   render::RenderSettings settings;
   render::ReferenceOptions reference;
 };

@@ -2,6 +2,7 @@
 // (lucent::render::run_viewer). Needs an X display; `xvfb-run -a lucent view ...` gives a virtual one.
 #include <cstdlib>
 #include <filesystem>
+#include <cstdio>
 #include <memory>
 #include <string>
 
@@ -19,6 +20,7 @@ struct ViewArguments {
   SceneArguments scene;
   float deform = 0;
   std::string script;
+  bool hide_panel = false;
 };
 
 void run_view(ViewArguments& args) {
@@ -41,6 +43,14 @@ void run_view(ViewArguments& args) {
   options.technique = args.scene.technique;
   options.deform_amplitude = args.deform;
   options.script = args.script;
+  options.hide_panel = args.hide_panel;
+  options.auto_exposure = args.scene.auto_exposure;
+  if (!args.scene.default_rig.empty()) {
+    std::string rig;
+    for (const auto& light : args.scene.default_rig) rig += " --light " + light;
+    std::fprintf(stderr, "view: no --light or --env: the default rig (key, fill, rim):%s\n",
+                 rig.c_str());
+  }
   const int status = render::run_viewer(options);
   if (status != 0) std::exit(status);
 #else
@@ -57,23 +67,29 @@ void register_view_command(CLI::App& app) {
       "view",
       "Preview a material on a mesh in a window (GLFW; needs an X display, e.g. xvfb-run -a). "
       "Left drag orbits, the wheel zooms, right drag moves a light, S saves a screenshot "
-      "(lucent_view_NNN.png), R restarts, H hides the panel, Esc quits. The panel switches the "
-      "material (library or file, reloaded when the file changes), technique and model, and has "
-      "sliders for N, M, q, K, W_s, W_l, T, exposure, object size and the deformer.");
+      "(lucent_view_NNN.png; the image without the panel), R restarts, H hides the panel, D shows "
+      "the difference against the last CPU reference of the same view, Esc quits. The panel "
+      "(scaled to the window) switches the material (library or file, reloaded when the file "
+      "changes), technique and model, edits the material (per channel mean free path and albedo, "
+      "eta, g), and has sliders for N, M, q, K, W_s, W_l, T, exposure, object size and the "
+      "deformer.");
   // The reference in the window runs pass after pass at half the window's resolution: fewer
   // samples per pass than `lucent render`'s default keep the first picture quick.
   args->scene.reference.surface_samples = 20000;
+  args->scene.reference.pixel_samples = 64;
   args->scene.size = "960x720";
   add_scene_options(cmd, args->scene, "window size WxH in pixels");
   cmd->add_option("--deform", args->deform,
                   "sine deformer: amplitude as a fraction of the bounding-box diagonal (0 = off, "
                   "at most 0.2); the mesh moves every frame and the maps restart with it")
       ->capture_default_str();
+  cmd->add_flag("--hide-panel", args->hide_panel, "start without the panel (H shows it)");
   cmd->add_option("--script", args->script,
                   "actions, one per frame, separated by ';': orbit DX DY, light DX DY (pixels), "
                   "zoom STEPS, set NAME VALUE (N M q K Ws Wl T exposure size deform technique "
                   "model), key LETTER, wait FRAMES, sleep SECONDS, settle (until the maps converge or the "
-                  "reference has a pass), screenshot FILE.png, restart, quit");
+                  "reference has a pass), screenshot FILE.png, panel on|off, difference on|off, restart, "
+                  "quit");
   cmd->callback([args] { run_view(*args); });
 }
 

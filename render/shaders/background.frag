@@ -7,11 +7,12 @@ layout(location = 0) out vec4 out_color;
 
 uniform mat4 u_inverse_view_proj;
 uniform bool u_has_environment;
+uniform vec3 u_backdrop;  // radiance where there is no environment map
 uniform sampler2D u_environment;
 
 void main() {
   if (!u_has_environment) {
-    out_color = vec4(0.0);
+    out_color = vec4(u_backdrop, 0.0);
     return;
   }
   vec4 near = u_inverse_view_proj * vec4(v_ndc, -1.0, 1.0);

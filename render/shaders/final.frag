@@ -15,6 +15,7 @@
 #include "math.glsl"
 #include "fresnel.glsl"
 #include "environment.glsl"
+#include "specular.glsl"
 
 in vec3 f_position;
 in vec3 f_normal;
@@ -37,6 +38,55 @@ uniform vec3 u_eye;          // mm
 uniform float u_eta;
 uniform bool u_has_environment;
 uniform sampler2D u_environment;
+
+// The lights, for the specular lobe (as in radiance_map.frag), and the light maps' surface
+// positions for its shadow test.
+layout(std140, binding = 0) uniform LightMatrices {
+  mat4 u_light_view_proj[LUCENT_MAX_LIGHTS];
+};
+uniform int u_light_count;
+uniform vec4 u_light_position[LUCENT_MAX_LIGHTS];
+uniform vec3 u_light_radiance[LUCENT_MAX_LIGHTS];
+uniform vec2 u_light_texel_mm[LUCENT_MAX_LIGHTS];
+uniform sampler2DArray u_light_positions;
+uniform float u_roughness;  // GGX alpha; 0: no lobe from point or directional lights
+uniform bool u_specular;
+
+// Whether light l reaches x_o: the light map's nearest surface on x_o's ray toward the light is
+// x_o itself (within a slope-scaled bias of a few light-map texels) and not something in front.
+bool lit_by(int l, vec3 x_o, vec3 n_o, vec3 w) {
+  vec4 clip = u_light_view_proj[l] * vec4(x_o, 1.0);
+  if (clip.w <= 0.0) return false;
+  vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
+  if (any(lessThan(uv, vec2(0.0))) || any(greaterThanEqual(uv, vec2(1.0)))) return false;
+  vec2 size = vec2(textureSize(u_light_positions, 0).xy);
+  vec4 p = texelFetch(u_light_positions, ivec3(ivec2(uv * size), l), 0);
+  if (p.w < 0.5) return true;
+  vec4 light = u_light_position[l];
+  float texel = u_light_texel_mm[l].x + u_light_texel_mm[l].y * distance(light.xyz, x_o);
+  float cos_i = max(dot(n_o, w), 0.05);
+  float bias = 2.0 * texel * (1.0 + min(sqrt(1.0 - cos_i * cos_i) / cos_i, 8.0));
+  return dot(p.xyz - x_o, w) <= bias;
+}
+
+vec3 specular_lights(vec3 x_o, vec3 n_o, vec3 w_o) {
+  vec3 sum = vec3(0.0);
+  if (!u_specular || !(u_roughness > 0.0)) return sum;
+  float cos_o = dot(n_o, w_o);
+  if (!(cos_o > 0.0)) return sum;
+  for (int l = 0; l < u_light_count; ++l) {
+    vec4 light = u_light_position[l];
+    bool is_point = light.w > 0.5;
+    vec3 to_light = is_point ? light.xyz - x_o : light.xyz;
+    vec3 w = normalize(to_light);
+    float cos_i = dot(n_o, w);
+    if (!(cos_i > 0.0) || !lit_by(l, x_o, n_o, w)) continue;
+    vec3 E = u_light_radiance[l] / (is_point ? dot(to_light, to_light) : 1.0);
+    vec3 h = normalize(w + w_o);
+    sum += E * ggx_reflection(cos_i, cos_o, dot(n_o, h), dot(h, w), u_roughness, u_eta);
+  }
+  return sum;
+}
 
 void main() {
   vec3 x_o = f_position;
@@ -69,5 +119,6 @@ void main() {
   float F_r = fresnel_reflectance(dot(n_o, w_o), u_eta);
   vec3 L = (1.0 - F_r) * L_ss;
   if (u_has_environment) L += F_r * environment_lookup(u_environment, reflect(-w_o, n_o));
+  L += specular_lights(x_o, n_o, w_o);
   out_color = vec4(L, seen > 0.0 ? 1.0 : 0.5);
 }

@@ -25,7 +25,8 @@ constexpr int kMaxLights = 16;
 // Texture units.
 constexpr GLuint kUnitLightPositions = 0, kUnitLightNormals = 1, kUnitPrevious = 2,
                  kUnitTabulated = 3;
-constexpr GLuint kUnitRadiance = 0, kUnitRadianceDepth = 1, kUnitEnvironment = 2;
+constexpr GLuint kUnitRadiance = 0, kUnitRadianceDepth = 1, kUnitEnvironment = 2,
+                 kUnitLightPositionsFinal = 3;
 // Uniform-block bindings (as in the shaders).
 constexpr GLuint kLightMatricesBinding = 0, kLayerCamerasBinding = 1, kDiscSamplesBinding = 2;
 
@@ -298,6 +299,7 @@ void RadianceMapRenderer::Impl::build_programs() {
   unit(final_program, "u_radiance", kUnitRadiance);
   unit(final_program, "u_radiance_depth", kUnitRadianceDepth);
   unit(final_program, "u_environment", kUnitEnvironment);
+  unit(final_program, "u_light_positions", kUnitLightPositionsFinal);
   unit(background_program, "u_environment", kUnitEnvironment);
   unit(present_program, "u_image", 0);
 
@@ -458,6 +460,11 @@ void RadianceMapRenderer::Impl::upload_lights() {
   glProgramUniform3fv(p, radiance_program.location("u_light_radiance"), kMaxLights,
                       radiance_.data());
   glProgramUniform2fv(p, radiance_program.location("u_light_texel_mm"), kMaxLights, texel.data());
+  const GLuint f = final_program.id();
+  glProgramUniform1i(f, final_program.location("u_light_count"), L);
+  glProgramUniform4fv(f, final_program.location("u_light_position"), kMaxLights, position.data());
+  glProgramUniform3fv(f, final_program.location("u_light_radiance"), kMaxLights, radiance_.data());
+  glProgramUniform2fv(f, final_program.location("u_light_texel_mm"), kMaxLights, texel.data());
 
   upload_disc(1, true);
 }
@@ -636,6 +643,7 @@ void RadianceMapRenderer::Impl::render_final() {
   glUniformMatrix4fv(background_program.location("u_inverse_view_proj"), 1, GL_FALSE,
                      inverse.data());
   glUniform1i(background_program.location("u_has_environment"), has_environment ? 1 : 0);
+  glUniform3fv(background_program.location("u_backdrop"), 1, scene.backdrop.data());
   if (has_environment) {
     glBindTextureUnit(kUnitEnvironment, environment.id());
     glBindSampler(kUnitEnvironment, environment_sampler.id());
@@ -659,7 +667,12 @@ void RadianceMapRenderer::Impl::render_final() {
   glUniform3fv(final_program.location("u_eye"), 1, scene.camera.eye.data());
   glUniform1i(final_program.location("u_has_environment"),
               has_environment && options.environment_reflection ? 1 : 0);
+  glUniform1f(final_program.location("u_roughness"), scene.roughness);
+  glUniform1i(final_program.location("u_specular"), scene.specular ? 1 : 0);
   glBindBufferBase(GL_UNIFORM_BUFFER, kLayerCamerasBinding, layer_cameras.id());
+  glBindBufferBase(GL_UNIFORM_BUFFER, kLightMatricesBinding, light_matrices.id());
+  glBindTextureUnit(kUnitLightPositionsFinal, light_positions.id());
+  glBindSampler(kUnitLightPositionsFinal, nearest.id());
   glBindTextureUnit(kUnitRadiance, radiance[current].id());
   glBindSampler(kUnitRadiance, mip_nearest.id());
   glBindTextureUnit(kUnitRadianceDepth, radiance_depth.id());
@@ -861,6 +874,12 @@ ImageRgb render_radiance_maps(const Scene& scene, const RenderSettings& settings
   RadianceMapRenderer renderer;
   renderer.setup(scene, settings, options);
   while (renderer.render_frame()) {
+    const int t = renderer.accumulated_frames();
+    if (options.on_snapshot && std::find(options.snapshot_frames.begin(),
+                                         options.snapshot_frames.end(), t) !=
+                                   options.snapshot_frames.end()) {
+      options.on_snapshot(t, renderer.read_image());
+    }
   }
   ImageRgb image = renderer.read_image();
   const RadianceMapStats& s = renderer.stats();

@@ -221,6 +221,8 @@ struct PixelHit {
   double fresnel_out = 0;  ///< F_t(eta, n_o . w_o)
   double fresnel_reflect = 0;
   Vec3f reflected = Vec3f::Zero();
+  Vec3f w_o = Vec3f::Zero();  ///< toward the eye
+  Vec3f g_o = Vec3f::Zero();  ///< geometric normal (shadow-ray offset)
 };
 
 /// One pass of the probe-ray sampler (reference_probes.cpp): for each object pixel i, the

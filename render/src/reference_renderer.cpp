@@ -20,6 +20,7 @@
 #include "lucent/materials/directional_dipole.h"
 #include "lucent/materials/error.h"
 #include "lucent/materials/fresnel.h"
+#include "lucent/materials/specular.h"
 #include "lucent/render/environment.h"
 #include "reference_common.h"
 
@@ -145,6 +146,36 @@ class ClusterTree {
   std::vector<Record> records_;
   std::vector<ClusterNode> nodes_;
 };
+
+// The specular lobe of every light at a pixel's point (materials/specular.h), with a shadow ray.
+Vec3f specular_radiance(const Scene& scene, const RayScene& rays, const PixelHit& hit, float eps) {
+  Vec3f sum = Vec3f::Zero();
+  if (!scene.specular || !(scene.roughness > 0)) return sum;
+  const double cos_o = hit.n_o.dot(hit.w_o);
+  if (!(cos_o > 0)) return sum;
+  for (const Light& light : scene.lights) {
+    Vec3f w;
+    double scale = 1, distance = kInf;
+    if (light.type == LightType::kDirectional) {
+      w = light.direction.normalized();
+    } else {
+      const Vec3f to_light = light.position - hit.x_o;
+      distance = to_light.norm();
+      if (!(distance > 0)) continue;
+      w = to_light / float(distance);
+      scale = 1.0 / (distance * distance);
+    }
+    const double cos_i = hit.n_o.dot(w);
+    if (!(cos_i > 0)) continue;
+    const Vec3f offset = hit.g_o.dot(w) >= 0 ? hit.g_o : Vec3f(-hit.g_o);
+    if (rays.occluded(hit.x_o + eps * offset, w, distance - eps)) continue;
+    const Vec3f h = (w + hit.w_o).normalized();
+    const double f = materials::ggx_reflection<double>(cos_i, cos_o, hit.n_o.dot(h), h.dot(w),
+                                                       scene.roughness, scene.material.ior);
+    sum += float(f * scale) * light.radiance;
+  }
+  return sum;
+}
 
 struct GatherCounters {
   std::uint64_t exact = 0;    ///< S_d evaluations for single samples (per channel)
@@ -379,10 +410,8 @@ ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
       unsigned tri = 0;
       float u = 0, v = 0;
       if (!rays.intersect(camera.eye, dir, tri, u, v)) {
-        if (environment) {
-          const Vec3f L = environment_lookup(*environment, dir);
-          for (int c = 0; c < 3; ++c) background.data[3 * p + c] = L[c];
-        }
+        const Vec3f L = environment ? environment_lookup(*environment, dir) : scene.backdrop;
+        for (int c = 0; c < 3; ++c) background.data[3 * p + c] = L[c];
         continue;
       }
       const auto& t = mesh.triangles[tri];
@@ -396,6 +425,10 @@ ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
       hit.fresnel_out = materials::fresnel_transmittance(cos_o, eta);
       hit.fresnel_reflect = 1.0 - hit.fresnel_out;
       hit.reflected = (2.0f * hit.n_o.dot(w_o) * hit.n_o - w_o).normalized();
+      hit.w_o = w_o;
+      hit.g_o = (mesh.positions[t[1]] - mesh.positions[t[0]])
+                    .cross(mesh.positions[t[2]] - mesh.positions[t[0]])
+                    .normalized();
       result.mask[p] = 1;
     }
   });
@@ -539,8 +572,10 @@ ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
       if (options.environment_reflection && environment) {
         reflection = float(hit.fresnel_reflect) * environment_lookup(*environment, hit.reflected);
       }
+      const Vec3f specular = specular_radiance(scene, rays, hit, eps);
       for (int c = 0; c < 3; ++c) {
-        image.data[3 * p + c] = float(hit.fresnel_out * accumulated[i][c]) + reflection[c];
+        image.data[3 * p + c] =
+            float(hit.fresnel_out * accumulated[i][c]) + reflection[c] + specular[c];
       }
     }
     const float blend = 1.0f / float(pass + 1);

@@ -57,4 +57,20 @@ void write_render_image(const std::filesystem::path& path, const acquire::ImageR
   }
 }
 
+float auto_exposure(const acquire::ImageRgb& linear, const std::vector<std::uint8_t>& mask) {
+  std::vector<float> luminance;
+  const std::size_t pixels = std::size_t(linear.width) * linear.height;
+  for (std::size_t p = 0; p < pixels; ++p) {
+    const float y = 0.2126f * linear.data[3 * p] + 0.7152f * linear.data[3 * p + 1] +
+                    0.0722f * linear.data[3 * p + 2];
+    const bool object = mask.empty() ? y > 0 : mask[p] != 0;
+    if (object && std::isfinite(y)) luminance.push_back(y);
+  }
+  if (luminance.empty()) return 1.0f;
+  const std::size_t k = std::min(luminance.size() - 1, std::size_t(0.95 * double(luminance.size())));
+  std::nth_element(luminance.begin(), luminance.begin() + std::ptrdiff_t(k), luminance.end());
+  const float p95 = luminance[k];
+  return p95 > 0 ? 2.0f / p95 : 1.0f;
+}
+
 }  // namespace lucent::render

@@ -2,279 +2,10 @@
 // renderer drawing into it, Dear ImGui's panel on top, and the CPU reference on a worker thread.
 #include "lucent/render/viewer.h"
 
-// clang-format off
-#include "gl_api.h"  // first: GLFW must not pull in the legacy GL header
-#define GLFW_INCLUDE_NONE
-#include <GLFW/glfw3.h>
-// clang-format on
-#include <imgui.h>
-#include <imgui_impl_glfw.h>
-#include <imgui_impl_opengl3.h>
-
-#include <algorithm>
-#include <array>
-#include <cctype>
-#include <cmath>
-#include <condition_variable>
-#include <cstdio>
-#include <filesystem>
-#include <mutex>
-#include <optional>
-#include <sstream>
-#include <thread>
-#include <utility>
-#include <vector>
-
-#include "lucent/acquire/image_io.h"
-#include "lucent/materials/error.h"
-#include "lucent/materials/material.h"
-#include "lucent/materials/profile_table.h"
-#include "lucent/render/radiance_maps.h"
-#include "lucent/render/tone_map.h"
+#include "viewer_impl.h"
 
 namespace lucent::render {
-namespace {
-
-// ---------------------------------------------------------------------------------------------
-// The script: one action per frame.
-
-struct ScriptAction {
-  std::string verb;
-  std::vector<std::string> args;
-};
-
-std::vector<ScriptAction> parse_script(const std::string& text) {
-  std::vector<ScriptAction> actions;
-  std::stringstream all(text);
-  std::string item;
-  while (std::getline(all, item, ';')) {
-    std::stringstream words(item);
-    ScriptAction action;
-    if (!(words >> action.verb)) continue;
-    for (std::string w; words >> w;) action.args.push_back(w);
-    const std::string& v = action.verb;
-    const std::size_t n = action.args.size();
-    const bool ok = ((v == "orbit" || v == "light" || v == "set") && n == 2) ||
-                    ((v == "zoom" || v == "wait" || v == "sleep" || v == "screenshot") &&
-                     n == 1) ||
-                    (v == "key" && n == 1 && action.args[0].size() == 1 &&
-                     std::isalpha(static_cast<unsigned char>(action.args[0][0]))) ||
-                    ((v == "restart" || v == "settle" || v == "quit") && n == 0);
-    if (!ok) {
-      const auto first = item.find_first_not_of(' ');
-      const auto last = item.find_last_not_of(' ');
-      throw Error("--script: '" + item.substr(first, last - first + 1) +
-                  "': expected orbit DX DY, light DX DY, zoom STEPS, set NAME VALUE, key LETTER, "
-                  "wait FRAMES, sleep SECONDS, settle, screenshot FILE.png, restart or quit");
-    }
-    actions.push_back(std::move(action));
-  }
-  return actions;
-}
-
-float parse_float(const std::string& text, const std::string& what) {
-  char* end = nullptr;
-  const float v = std::strtof(text.c_str(), &end);
-  if (text.empty() || *end != '\0' || !std::isfinite(v)) {
-    throw Error("--script: " + what + ": expected a number, got '" + text + "'");
-  }
-  return v;
-}
-
-// ---------------------------------------------------------------------------------------------
-// The CPU reference on a worker thread: one pass after another (new samples each), summed until the
-// scene changes; the main thread shows the running mean.
-
-class ReferenceWorker {
- public:
-  ReferenceWorker() : thread_([this] { loop(); }) {}
-  ~ReferenceWorker() {
-    {
-      std::lock_guard lock(mutex_);
-      quit_ = true;
-    }
-    wake_.notify_all();
-    thread_.join();
-  }
-
-  /// Starts over on `scene` (what the worker is doing now is thrown away when it finishes).
-  void start(const Scene& scene, DiffusionModel model, const ReferenceOptions& options) {
-    {
-      std::lock_guard lock(mutex_);
-      job_ = Job{scene, model, options, ++generation_};
-      sum_ = ImageRgb();
-      passes_ = 0;
-      error_.clear();
-      fresh_ = false;
-    }
-    wake_.notify_all();
-  }
-  /// Stops after the current pass.
-  void pause() {
-    std::lock_guard lock(mutex_);
-    job_.reset();
-    ++generation_;
-  }
-  /// The mean over the passes so far, when a pass has finished since the last call.
-  bool take(ImageRgb& mean, int& passes, std::string& error) {
-    std::lock_guard lock(mutex_);
-    error = error_;
-    if (!fresh_) return false;
-    fresh_ = false;
-    mean = sum_;
-    for (float& v : mean.data) v /= float(passes_);
-    passes = passes_;
-    return true;
-  }
-
- private:
-  struct Job {
-    Scene scene;
-    DiffusionModel model;
-    ReferenceOptions options;
-    std::uint64_t generation;
-  };
-
-  void loop() {
-    for (;;) {
-      Job job;
-      int pass = 0;
-      {
-        std::unique_lock lock(mutex_);
-        wake_.wait(lock, [&] { return quit_ || job_.has_value(); });
-        if (quit_) return;
-        job = *job_;
-        pass = passes_;
-      }
-      ReferenceOptions options = job.options;
-      options.passes = 1;
-      options.seed = job.options.seed + std::uint64_t(pass) * 7919;
-      options.progress = nullptr;
-      std::optional<ImageRgb> image;
-      std::string error;
-      try {
-        image = render_reference(job.scene, job.model, options).image;
-      } catch (const std::exception& e) {
-        error = e.what();
-      }
-      std::lock_guard lock(mutex_);
-      if (job.generation != generation_) continue;  // the scene changed meanwhile
-      if (!image) {
-        error_ = error;
-        job_.reset();
-        continue;
-      }
-      if (sum_.data.empty()) sum_ = ImageRgb(image->width, image->height);
-      for (std::size_t i = 0; i < sum_.data.size(); ++i) sum_.data[i] += image->data[i];
-      ++passes_;
-      fresh_ = true;
-      if (passes_ >= kMaxPasses) job_.reset();
-    }
-  }
-
-  static constexpr int kMaxPasses = 1000;
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  std::optional<Job> job_;
-  std::uint64_t generation_ = 0;
-  ImageRgb sum_;
-  int passes_ = 0;
-  bool fresh_ = false;
-  bool quit_ = false;
-  std::string error_;
-  std::thread thread_;  // last: starts after the members it uses exist
-};
-
-// ---------------------------------------------------------------------------------------------
-
-struct GlfwSession {
-  GlfwSession() {
-    glfwSetErrorCallback([](int, const char* what) { last_error() = what; });
-    if (!glfwInit()) {
-      throw Error(
-          "view: no window system (" + last_error() +
-          "); lucent view needs an X display: run it under `xvfb-run -a` for a virtual one");
-    }
-  }
-  ~GlfwSession() { glfwTerminate(); }
-  static std::string& last_error() {
-    static std::string text;
-    return text;
-  }
-};
-
-constexpr std::array<int, 6> kMapSizes = {64, 128, 256, 512, 1024, 2048};
-
-class Viewer {
- public:
-  explicit Viewer(const ViewerOptions& options);
-  ~Viewer();
-  int run();
-
- private:
-  void frame();
-  void handle_mouse();
-  void handle_keys();
-  void run_script_step();
-  void draw_ui();
-  void draw_reference();
-
-  void view_changed();
-  void scene_changed();  // lights, material or geometry: restart whatever is accumulating
-  void rebuild_maps();   // new RenderSettings: new textures and programs
-  void set_parameter(const std::string& name, const std::string& value);
-  void load_material(const std::string& source);
-  void set_object_size(double mm);
-  void set_deform(float amplitude);
-  void set_technique(const std::string& technique);
-  void screenshot(const std::filesystem::path& path);
-  std::filesystem::path next_screenshot_path() const;
-
-  ViewerOptions options_;
-  GlfwSession glfw_;
-  GLFWwindow* window_ = nullptr;
-  int width_ = 0, height_ = 0;  // framebuffer pixels
-
-  Scene scene_;
-  Mesh rest_mesh_;  // undeformed, at the current object size
-  std::optional<SineDeformer> deformer_;
-  float deform_amplitude_ = 0;
-  double object_size_mm_ = 100;
-  RenderSettings settings_, pending_;
-  bool model_from_material_ = true;
-  OrbitView view_;
-  std::string technique_;
-  std::unique_ptr<RadianceMapRenderer> maps_;
-  std::unique_ptr<ReferenceWorker> reference_;
-  FileWatcher watcher_;
-  double last_watch_ = 0;
-  std::string material_source_;
-  std::array<char, 512> material_path_{};
-  int selected_light_ = 0;
-
-  // The reference image on screen.
-  GLuint reference_texture_ = 0, reference_fbo_ = 0;
-  int reference_w_ = 0, reference_h_ = 0, reference_passes_ = 0;
-  std::string reference_error_;
-
-  std::vector<ScriptAction> script_;
-  std::size_t script_pos_ = 0;
-  double sleep_until_ = 0, settle_deadline_ = 0;
-  bool settling_ = false;
-  static constexpr double kSettleTimeout = 300;  // s
-  std::filesystem::path screenshot_path_;
-  int wait_frames_ = 0;
-  bool quit_ = false;
-  bool show_ui_ = true;
-  std::string message_;  // last error or notice, shown in the panel
-  std::vector<int> keys_;
-  float scroll_ = 0;
-  bool dragging_ = false;
-  double last_x_ = 0, last_y_ = 0;
-  long frames_drawn_ = 0;
-  int restarts_ = 0, screenshots_ = 0;
-  double frame_ms_ = 0, last_time_ = 0;
-};
+namespace viewer_detail {
 
 Viewer::Viewer(const ViewerOptions& options)
     : options_(options),
@@ -288,6 +19,8 @@ Viewer::Viewer(const ViewerOptions& options)
       technique_(options.technique),
       material_source_(options.material_source) {
   script_ = parse_script(options.script);
+  show_ui_ = !options.hide_panel;
+  auto_exposure_ = options.auto_exposure;
   settings_.validate();
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
@@ -313,7 +46,6 @@ Viewer::Viewer(const ViewerOptions& options)
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini in the user's folder
-  ImGui::GetIO().FontGlobalScale = 0.9f;
   ImGui::StyleColorsDark();
   ImGui::GetStyle().ScaleAllSizes(0.8f);
   ImGui_ImplGlfw_InitForOpenGL(window_, true);
@@ -392,6 +124,8 @@ void Viewer::frame() {
 
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
+  // The panel's text scales with the window: 1 at 720 pixels high, within 0.55..1.6.
+  ImGui::GetIO().FontGlobalScale = std::clamp(float(height_) / 720.0f, 0.55f, 1.6f);
   ImGui::NewFrame();
   if (show_ui_) draw_ui();
   ImGui::Render();
@@ -401,15 +135,25 @@ void Viewer::frame() {
     if (technique_ == "maps" && maps_) {
       maps_->render_frame();
       glBindFramebuffer(GL_FRAMEBUFFER, 0);
-      maps_->present(settings_.exposure, width_, height_);
+      if (auto_exposure_ && maps_->accumulated_frames() >= 1) {
+        settings_.exposure = pending_.exposure = auto_exposure(maps_->read_image());
+        auto_exposure_ = false;
+      }
+      if (show_difference_) {
+        draw_difference();
+      } else {
+        maps_->present(settings_.exposure, width_, height_);
+      }
     } else {
       draw_reference();
     }
   }
-  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
   ++frames_drawn_;
-  // Screenshots read the back buffer before the swap.
+  // Screenshots read the back buffer before the swap and before the panel is drawn: they show
+  // the image alone (the panel's numbers go to stdout).
   if (!screenshot_path_.empty()) screenshot(std::exchange(screenshot_path_, {}));
+  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+  if (!panel_screenshot_path_.empty()) screenshot(std::exchange(panel_screenshot_path_, {}));
   glfwSwapBuffers(window_);
 }
 
@@ -456,6 +200,12 @@ void Viewer::run_script_step() {
     quit_ = true;
   } else if (a.verb == "screenshot") {
     screenshot_path_ = a.args[0];  // taken in frame(), after drawing
+  } else if (a.verb == "screenshot-panel") {
+    panel_screenshot_path_ = a.args[0];  // with the panel on it
+  } else if (a.verb == "panel") {
+    show_ui_ = a.args[0] == "on";
+  } else if (a.verb == "difference") {
+    show_difference_ = a.args[0] == "on";
   }
 }
 
@@ -465,6 +215,7 @@ void Viewer::handle_keys() {
   for (int key : keys) {
     if (key == GLFW_KEY_ESCAPE) quit_ = true;
     if (key == GLFW_KEY_H) show_ui_ = !show_ui_;
+    if (key == GLFW_KEY_D) show_difference_ = !show_difference_;
     if (key == GLFW_KEY_R) scene_changed();
     if (key == GLFW_KEY_S) screenshot_path_ = next_screenshot_path();  // taken after drawing
   }
@@ -503,6 +254,7 @@ void Viewer::handle_mouse() {
 }
 
 void Viewer::view_changed() {
+  ++scene_version_;  // the cached reference was of the old view
   scene_.camera = view_.camera(scene_.mesh, std::max(width_, 1), std::max(height_, 1));
   if (maps_) maps_->set_camera(scene_.camera);  // the maps do not depend on the view
   if (technique_ == "reference") scene_changed();
@@ -510,6 +262,7 @@ void Viewer::view_changed() {
 
 void Viewer::scene_changed() {
   ++restarts_;
+  ++scene_version_;
   if (maps_) maps_->restart();
   if (technique_ == "reference") {
     // Half the window's resolution in each direction: four times fewer pixels to integrate.
@@ -641,16 +394,78 @@ void Viewer::set_technique(const std::string& technique) {
     throw Error("technique: expected maps or reference, got '" + technique + "'");
   }
   technique_ = technique;
+  // Same scene, another technique: the cached reference stays valid for the difference view.
+  const std::uint64_t version = scene_version_;
   scene_changed();
+  scene_version_ = version;
 }
 
 void Viewer::draw_reference() {
   ImageRgb mean;
   int passes = 0;
   if (reference_->take(mean, passes, reference_error_)) {
+    cached_reference_ = mean;
+    reference_version_ = scene_version_;
+    if (auto_exposure_) {
+      settings_.exposure = pending_.exposure = auto_exposure(mean);
+      auto_exposure_ = false;
+    }
+    reference_passes_ = passes;
+  }
+  glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT);
+  if (reference_passes_ > 0 && !cached_reference_.data.empty()) {
+    blit(cached_reference_, settings_.exposure);
+  }
+}
+
+void Viewer::draw_difference() {
+  glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT);
+  if (reference_version_ != scene_version_ || cached_reference_.data.empty()) {
+    difference_text_ = "no reference for this view: switch to the CPU reference, let it run a "
+                       "pass, come back";
+    maps_->present(settings_.exposure, width_, height_);
+    return;
+  }
+  // The maps' image averaged 2 x 2 down to the reference's half resolution.
+  const ImageRgb full = maps_->read_image();
+  const ImageRgb& ref = cached_reference_;
+  ImageRgb small(ref.width, ref.height, 0.0f);
+  const int fx = std::max(1, full.width / ref.width), fy = std::max(1, full.height / ref.height);
+  for (int y = 0; y < ref.height; ++y)
+    for (int x = 0; x < ref.width; ++x)
+      for (int c = 0; c < 3; ++c) {
+        float sum = 0;
+        for (int j = 0; j < fy; ++j)
+          for (int i = 0; i < fx; ++i)
+            sum += full.at(std::min(full.width - 1, x * fx + i), std::min(full.height - 1, y * fy + j), c);
+        small.at(x, y, c) = sum / float(fx * fy);
+      }
+  const auto mask = nonzero_mask(ref);
+  try {
+    const ImageDifference d = compare_images(small, ref, mask);
+    difference_text_ = d.to_string();
+    if (frames_drawn_ - difference_frame_ >= 30) {
+      std::printf("view: maps (frame %d) against the reference (%d passes): %s\n",
+                  maps_->accumulated_frames(), reference_passes_, difference_text_.c_str());
+      difference_frame_ = frames_drawn_;
+    }
+    ImageRgb diff(ref.width, ref.height, 0.0f);
+    for (std::size_t p = 0; p < mask.size(); ++p)
+      for (int c = 0; c < 3; ++c)
+        diff.data[3 * p + std::size_t(c)] = mask[p] ? float(std::abs(small.data[3 * p + std::size_t(c)] - ref.data[3 * p + std::size_t(c)]) / d.reference_mean) : 0.0f;
+    blit(diff, 10.0f);  // 10 x the relative difference: white is 10% of the mean
+  } catch (const Error& e) {
+    difference_text_ = e.what();
+  }
+}
+
+void Viewer::blit(const ImageRgb& mean, float exposure) {
+  {
     // Tone-mapped on the CPU with the same curve as the maps' present(), then blitted.
     ToneMapOptions tone;
-    tone.exposure = settings_.exposure;
+    tone.exposure = exposure;
     const acquire::RawImage srgb = tone_map(mean, tone);
     std::vector<std::uint8_t> rgb(srgb.data.size());
     const float to_byte = 255.0f / float(srgb.max_value);
@@ -670,11 +485,8 @@ void Viewer::draw_reference() {
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     glTextureSubImage2D(reference_texture_, 0, 0, 0, mean.width, mean.height, GL_RGB,
                         GL_UNSIGNED_BYTE, rgb.data());
-    reference_passes_ = passes;
   }
-  glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
-  glClear(GL_COLOR_BUFFER_BIT);
-  if (reference_fbo_ != 0 && reference_passes_ > 0) {
+  if (reference_fbo_ != 0) {
     // Row 0 of the image is the top: flip while blitting.
     glBlitNamedFramebuffer(reference_fbo_, 0, 0, 0, reference_w_, reference_h_, 0, height_,
                            width_, 0, GL_COLOR_BUFFER_BIT, GL_LINEAR);
@@ -714,133 +526,10 @@ void Viewer::screenshot(const std::filesystem::path& path) {
   }
 }
 
-bool slider_done() { return ImGui::IsItemDeactivatedAfterEdit(); }
-
-void section(const char* title) {
-  ImGui::Separator();
-  ImGui::TextDisabled("%s", title);
-}
-
-void Viewer::draw_ui() {
-  ImGui::SetNextWindowPos(ImVec2(6, 6), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowBgAlpha(0.75f);
-  ImGui::Begin("lucent", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
-  ImGui::PushItemWidth(130);
-
-  // Material: the library, or a file (reloaded when it changes on disk).
-  if (ImGui::BeginCombo("material", scene_.material.name.c_str())) {
-    for (const std::string& name : materials::library_material_names()) {
-      if (ImGui::Selectable(name.c_str(), name == material_source_)) load_material(name);
-    }
-    ImGui::EndCombo();
-  }
-  ImGui::InputText("file", material_path_.data(), material_path_.size());
-  ImGui::SameLine();
-  if (ImGui::Button("load")) load_material(material_path_.data());
-
-  // Technique and model.
-  int technique = technique_ == "maps" ? 0 : 1;
-  if (ImGui::RadioButton("radiance maps", &technique, 0)) set_technique("maps");
-  ImGui::SameLine();
-  if (ImGui::RadioButton("CPU reference", &technique, 1)) set_technique("reference");
-  int model = settings_.model == DiffusionModel::kDirectionalDipole ? 0 : 1;
-  if (ImGui::RadioButton("directional dipole", &model, 0) ||
-      ImGui::RadioButton("standard dipole", &model, 1)) {
-    settings_.model = pending_.model =
-        model == 0 ? DiffusionModel::kDirectionalDipole : DiffusionModel::kDipole;
-    model_from_material_ = false;
-    rebuild_maps();
-    scene_changed();
-  }
-
-  // The speed/accuracy knobs: applied when a slider is let go (they rebuild the maps).
-  section("radiance maps");
-  bool apply = false;
-  int disc = pending_.disc_selection == DiscSelection::kStrata ? 0 : 1;
-  if (ImGui::RadioButton("strata", &disc, 0) || ImGui::RadioButton("N nearest (seed)", &disc, 1)) {
-    pending_.disc_selection = disc == 0 ? DiscSelection::kStrata : DiscSelection::kNearest;
-    apply = true;
-  }
-  ImGui::SliderInt("N samples", &pending_.samples, 1, std::min(pending_.disc_points, 512));
-  apply |= slider_done();
-  ImGui::SliderInt("M disc points", &pending_.disc_points, 1, 4000);
-  apply |= slider_done();
-  float q = float(pending_.q);
-  if (ImGui::SliderFloat("q", &q, 0.1f, 10.0f, "%.2f", ImGuiSliderFlags_Logarithmic)) pending_.q = q;
-  apply |= slider_done();
-  ImGui::SliderInt("K directions", &pending_.directions, 1, 64);
-  apply |= slider_done();
-  ImGui::SliderInt("T frames", &pending_.frames, 1, 1000);
-  apply |= slider_done();
-  for (auto [label, value] : {std::pair{"W_s radiance map", &pending_.radiance_map_size},
-                              std::pair{"W_l light map", &pending_.light_map_size}}) {
-    int index = int(std::find(kMapSizes.begin(), kMapSizes.end(), *value) - kMapSizes.begin());
-    index = std::min(index, int(kMapSizes.size()) - 1);
-    if (ImGui::SliderInt(label, &index, 0, int(kMapSizes.size()) - 1,
-                         std::to_string(kMapSizes[std::size_t(index)]).c_str())) {
-      *value = kMapSizes[std::size_t(index)];
-    }
-    apply |= slider_done();
-  }
-  if (apply) {
-    pending_.samples = std::min(pending_.samples, pending_.disc_points);
-    try {
-      pending_.validate();
-      settings_ = pending_;
-      rebuild_maps();
-    } catch (const Error& e) {
-      message_ = e.what();
-      pending_ = settings_;
-    }
-  }
-
-  section("scene");
-  ImGui::SliderFloat("exposure", &settings_.exposure, 0.01f, 100.0f, "%.3g",
-                     ImGuiSliderFlags_Logarithmic);
-  pending_.exposure = settings_.exposure;
-  float size = float(object_size_mm_);
-  ImGui::SliderFloat("object size mm", &size, 1.0f, 2000.0f, "%.4g", ImGuiSliderFlags_Logarithmic);
-  if (slider_done()) set_object_size(size);
-  float deform = deform_amplitude_;
-  ImGui::SliderFloat("deform", &deform, 0.0f, 0.2f, "%.3f");
-  if (slider_done()) set_deform(deform);
-  if (scene_.lights.size() > 1) {
-    ImGui::SliderInt("dragged light", &selected_light_, 0, int(scene_.lights.size()) - 1);
-  }
-  if (technique_ == "reference" && deformer_) ImGui::TextUnformatted("(the deformer pauses for the reference)");
-
-  section("progress");
-  if (technique_ == "maps" && maps_) {
-    const RadianceMapStats& s = maps_->stats();
-    ImGui::Text("frames %d / %d%s", maps_->accumulated_frames(), settings_.frames,
-                maps_->converged() ? "  (converged)" : "");
-    const StageTimes& t = s.last_wall;
-    ImGui::Text("light map   %8.2f ms", t.light_map_ms);
-    ImGui::Text("radiance map%8.2f ms", t.radiance_map_ms);
-    ImGui::Text("mip blur    %8.2f ms", t.mip_blur_ms);
-    ImGui::Text("final       %8.2f ms", t.final_ms);
-    ImGui::Text("window frame %7.1f ms", frame_ms_);
-    ImGui::Text("disc: sigma* %.3g /mm, rho %.3g of R %.3g mm", s.sigma_star_per_mm,
-                s.used_disc_radius_mm, s.disc_radius_mm);
-    if (s.uncovered_fraction > 0) {
-      ImGui::Text("unseen by every layer: %.1f%% of pixels", 100 * s.uncovered_fraction);
-    }
-  } else {
-    ImGui::Text("reference passes %d (%d samples each)", reference_passes_,
-                options_.reference.surface_samples);
-    if (!reference_error_.empty()) ImGui::TextWrapped("%s", reference_error_.c_str());
-  }
-  if (!message_.empty()) ImGui::TextWrapped("%s", message_.c_str());
-  ImGui::TextDisabled("drag: orbit  right drag: light  wheel: zoom");
-  ImGui::TextDisabled("S screenshot  R restart  H hide  Esc quit");
-  ImGui::PopItemWidth();
-  ImGui::End();
-}
-
-}  // namespace
+}  // namespace viewer_detail
 
 int run_viewer(const ViewerOptions& options) {
-  Viewer viewer(options);
+  viewer_detail::Viewer viewer(options);
   return viewer.run();
 }
 

@@ -24,6 +24,7 @@
 #include "lucent/materials/fresnel.h"
 #include "lucent/materials/material.h"
 #include "lucent/render/gl_context.h"
+#include "lucent/render/image_compare.h"
 #include "lucent/render/radiance_maps.h"
 #include "lucent/render/reference_renderer.h"
 #include "radiance_maps_sampling.h"
@@ -275,43 +276,20 @@ TEST_F(RadianceMapsTest, AccumulationStopsAfterTFrames) {
   EXPECT_EQ(renderer.accumulated_frames(), 1);
 }
 
-TEST_F(RadianceMapsTest, RejectsWhatItCannotRender) {
-  Scene scene = sphere_scene(16);
-  RadianceMapRenderer renderer;
-  scene.lights.clear();
-  EXPECT_THROW(renderer.setup(scene, tiny_settings()), Error);
-  scene = sphere_scene(16);
-  RenderSettings settings = tiny_settings();
-  settings.samples = 2000;  // N > M
-  EXPECT_THROW(renderer.setup(scene, settings), Error);
-}
-
-// Relative RMSE over the object's pixels against the CPU reference (render_reference, 4 passes of
-// 20,000 surface samples), for marble, potato and ketchup under one directional light, one point
-// light and both, on a sphere and on the coarsest dragon (40 px, K = 8, W_s = W_l = 64, N = 16).
+// The maps against the CPU reference (probes, 2048 per pixel: ~1.5% per-pixel noise at 40 px),
+// for marble, potato and ketchup under one directional light, one point light and both, on a
+// sphere and on the coarsest dragon (40 px, K = 8, W_s = W_l = 64, N = 16 of M = 256, T = 16).
+// The bounds are the targets for the light settings (relative RMSE 8%, channel means 3%;
+// ketchup 10%), not measurements: at these smaller maps the measured errors are well inside them
+// (see the printout), so a regression in the weights, visibility or blur fails them.
 //
-// The seed's disc (DiscSelection::kNearest: the N = 16 of M = 1000 points nearest x_o every frame)
-// gathers a disc of only rho = 2-3 mm and misses the profile beyond it: its image is 0.5-0.65 of the
-// reference's mean, worst in the channel that scatters farthest, and more frames only rotate the
-// same radii (measured relative RMSE 0.51-0.97). The bound on it is its mean ratio in [0.3, 0.8]:
-// the test documents the bias, it does not excuse it.
-//
-// lucent's default (kStrata, N = 16 of M = 128: every point gathered for every light after
-// L M / N = 8-16 frames) converges toward the reference. Measured after T = 16 frames (llvmpipe,
-// this commit), relative RMSE per case (directional, point, both): sphere marble 0.30 0.33 0.28,
-// potato 0.11 0.12 0.11, ketchup 0.51 0.41 0.40; dragon:4 marble 0.58 0.47 0.47, potato 0.24 0.22
-// 0.21, ketchup 0.79 0.55 0.65; mean ratio 0.80-1.05. What remains is per-texel noise of the
-// M-point estimate (the heavy e^(sigma* r) weights of the far strata; ketchup's short green and
-// blue profiles under a disc shaped by its long red one suffer most), the 64-texel maps (the
-// dragon's thin parts are a few texels wide) and the reference's own noise (80,000 samples). The
-// bounds are the worst measured case per mesh and material plus 30%: the maps are deterministic
-// for one driver (Halton points, hashed rotations) and the reference for one seed, so the margin is
-// for other drivers' rounding, while a wrong weight, visibility or blur moves the error by factors.
-// The first frame's error (mip level 2 blur) is 1.7-5: one point per stratum is a noisy estimate;
-// T frames bring it down 2.4-12 fold (required: at least 2).
+// The seed's own disc (DiscDistribution::kExponential with DiscSelection::kNearest, M = 1000):
+// the N = 16 points nearest x_o stand for a disc of only rho = 2-3 mm and miss the profile beyond
+// it, so its image is 0.3-0.8 of the reference's mean, worst in the channel that scatters
+// farthest: the test documents that bias, it does not excuse it.
 struct AccuracyCase {
   const char* material;
-  double bound;  // relative RMSE after T frames, strata
+  double rmse_bound, mean_bound;  // relative RMSE; |channel mean ratio - 1|
 };
 
 void check_accuracy_against_reference(const std::string& mesh,
@@ -321,13 +299,13 @@ void check_accuracy_against_reference(const std::string& mesh,
       Scene scene;
       scene.mesh = load_mesh(mesh, 100);
       scene.material = materials::load_material(c.material);
+      scene.specular = false;  // the subsurface term: the specular lobe is the same in both
       if (lights != "point") scene.lights.push_back(parse_light("directional:1,0.5,0.5:1,1,1"));
       if (lights != "directional")
         scene.lights.push_back(parse_light("point:-60,60,80:5000,5000,5000"));
       scene.camera = orbit_camera(scene.mesh, 0, 0, 3.4f, 40, 40);
       ReferenceOptions reference_options;
-      reference_options.surface_samples = 20000;
-      reference_options.passes = 4;
+      reference_options.pixel_samples = 2048;
       reference_options.threads = 2;
       const ReferenceImage reference =
           render_reference(scene, DiffusionModel::kDirectionalDipole, reference_options);
@@ -336,6 +314,12 @@ void check_accuracy_against_reference(const std::string& mesh,
       const auto error = [&](const ImageRgb& image) {
         return masked_rmse(image, reference.image, reference.mask) / mean;
       };
+      const auto worst_channel_ratio = [&](const ImageRgb& image) {
+        const ImageDifference d = compare_images(image, reference.image, reference.mask);
+        double worst = 0;
+        for (double r : d.mean_ratio) worst = std::max(worst, std::abs(r - 1));
+        return worst;
+      };
 
       RenderSettings settings;
       settings.directions = 8;
@@ -343,7 +327,8 @@ void check_accuracy_against_reference(const std::string& mesh,
       settings.radiance_map_size = 64;
       settings.light_map_size = 64;
 
-      // The seed's N nearest of M.
+      // The seed's N nearest of M exponentially biased points.
+      settings.disc_distribution = DiscDistribution::kExponential;
       settings.disc_selection = DiscSelection::kNearest;
       settings.disc_points = 1000;
       settings.frames = 4;
@@ -352,47 +337,40 @@ void check_accuracy_against_reference(const std::string& mesh,
       while (nearest.render_frame()) {
       }
       const ImageRgb nearest_image = nearest.read_image();
-      const double nearest_error = error(nearest_image);
       const double nearest_ratio = masked_mean(nearest_image, reference.mask) / mean;
 
-      // Strata.
+      // lucent's default disc: the profile's own, in strata.
+      settings.disc_distribution = DiscDistribution::kProfile;
       settings.disc_selection = DiscSelection::kStrata;
-      settings.disc_points = 128;
+      settings.disc_points = 256;
       settings.frames = 16;
       RadianceMapRenderer strata;
       strata.setup(scene, settings);
-      strata.render_frame();
-      const double first = error(strata.read_image());
       while (strata.render_frame()) {
       }
       const ImageRgb image = strata.read_image();
-      const double last = error(image);
-      const double ratio = masked_mean(image, reference.mask) / mean;
+      const double last = error(image), channel = worst_channel_ratio(image);
       std::printf(
-          "%-9s %-8s %-11s relative RMSE: nearest %.3f (mean ratio %.3f); strata 1 frame %.3f, "
-          "16 frames %.3f (mean ratio %.3f)\n",
-          mesh.c_str(), c.material, lights.c_str(), nearest_error, nearest_ratio, first, last,
-          ratio);
+          "%-9s %-8s %-11s relative RMSE %.4f, worst channel mean off by %.4f (seed's nearest: "
+          "mean ratio %.3f)\n",
+          mesh.c_str(), c.material, lights.c_str(), last, channel, nearest_ratio);
       const std::string what = mesh + " " + c.material + " " + lights;
+      EXPECT_LT(last, c.rmse_bound) << what;
+      EXPECT_LT(channel, c.mean_bound) << what;
       EXPECT_GT(nearest_ratio, 0.3) << what;
       EXPECT_LT(nearest_ratio, 0.8) << what;
-      EXPECT_LT(last, c.bound) << what;
-      EXPECT_LT(last, first / 2) << what;
-      EXPECT_LT(last, nearest_error) << what;
-      EXPECT_GT(ratio, 0.7) << what;
-      EXPECT_LT(ratio, 1.25) << what;
     }
   }
 }
 
 TEST_F(RadianceMapsTest, ErrorAgainstTheCpuReferenceOnASphere) {
-  check_accuracy_against_reference("sphere",
-                                   {{"marble", 0.43}, {"potato", 0.16}, {"ketchup", 0.66}});
+  check_accuracy_against_reference(
+      "sphere", {{"marble", 0.08, 0.03}, {"potato", 0.08, 0.03}, {"ketchup", 0.10, 0.03}});
 }
 
 TEST_F(RadianceMapsTest, ErrorAgainstTheCpuReferenceOnTheCoarseDragon) {
-  check_accuracy_against_reference("dragon:4",
-                                   {{"marble", 0.75}, {"potato", 0.32}, {"ketchup", 1.03}});
+  check_accuracy_against_reference(
+      "dragon:4", {{"marble", 0.08, 0.03}, {"potato", 0.08, 0.03}, {"ketchup", 0.10, 0.03}});
 }
 
 // Invariant: a medium that absorbs nothing (sigma_tr = 0: the disc is uniform, sigma* = 0, and the

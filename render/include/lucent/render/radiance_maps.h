@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -48,6 +49,10 @@ struct RadianceMapOptions {
   bool time_stages = true;
   /// Add F_r(eta, n_o . w_o) L_env(reflect(-w_o, n_o)) where the scene has an environment map.
   bool environment_reflection = true;
+  /// render_radiance_maps calls this with the image after each frame listed in `snapshot_frames`
+  /// (`lucent render --snapshots`: convergence against frame count).
+  std::function<void(int frame, const ImageRgb& image)> on_snapshot;
+  std::vector<int> snapshot_frames;
 
   std::string to_string() const;
 };

@@ -66,6 +66,11 @@ struct Scene {
   /// Environment map shown as the background (linear RGB, lat-long), optional; its light enters
   /// through `lights` (importance-sampled directional lights).
   std::optional<std::filesystem::path> environment;
+  /// The surface's specular lobe for every light (materials/specular.h): GGX width alpha; 0 = a
+  /// smooth interface (no highlight from point or directional lights). `--roughness`.
+  float roughness = 0.1f;
+  bool specular = true;  ///< `--specular off` renders the subsurface term alone
+  Vec3f backdrop{0, 0, 0};  ///< radiance of the background where no environment map is given
 };
 
 /// Parses `directional:DX,DY,DZ:R,G,B` or `point:X,Y,Z:R,G,B`; throws lucent::Error naming --light.

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "lucent/acquire/image.h"
 
@@ -34,6 +35,12 @@ acquire::RawImage tone_map(const acquire::ImageRgb& linear, const ToneMapOptions
 void write_render_image(const std::filesystem::path& path, const acquire::ImageRgb& linear,
                         const ToneMapOptions& options = {},
                         const std::map<std::string, std::string>& attributes = {});
+
+/// `--exposure auto`: the scale that puts the 95th percentile of the object's luminance
+/// (0.2126 R + 0.7152 G + 0.0722 B over pixels where mask != 0, or every non-black pixel when the
+/// mask is empty) at 2, which the tone curve maps to 2/3: the bright side is bright and still
+/// shaded (Reinhard never clips). 1 for an all-black image.
+float auto_exposure(const acquire::ImageRgb& linear, const std::vector<std::uint8_t>& mask = {});
 
 /// True for the extensions write_render_image accepts (.png, .exr; any case).
 bool is_render_image_path(const std::filesystem::path& path);

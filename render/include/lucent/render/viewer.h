@@ -33,11 +33,15 @@ struct ViewerOptions {
   ///   zoom STEPS                  scroll-wheel steps (up = closer)
   ///   set NAME VALUE              N, M, q, K, Ws, Wl, T, exposure, size, deform, disc,
   ///                               technique, model
-  ///   key LETTER                 a key press (S, R, H)
+  ///   key LETTER                 a key press (S, R, H, D)
+  ///   panel on|off | difference on|off   the panel; the difference view against the reference
+  ///   screenshot-panel FILE.png   a screenshot with the panel (`screenshot` leaves it out)
   ///   wait FRAMES | sleep SECONDS
   ///   settle                      until the maps converge or the reference has a pass (<= 300 s)
   ///   screenshot FILE.png | restart | quit
   std::string script;
+  bool hide_panel = false;     ///< --hide-panel: start without the panel (H toggles it)
+  bool auto_exposure = false;  ///< --exposure auto: set once from the first images (tone_map.h)
 };
 
 /// Opens the window and runs until it is closed (or the script quits). Returns the exit status.
