@@ -1,5 +1,6 @@
 // `lucent compare`: how far a render is from a reference (relative RMSE, per-channel mean ratios)
 // over the pixels where the reference shows the object.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -21,6 +22,7 @@ struct CompareArguments {
   bool json = false;
   std::string difference;
   float scale = 10;
+  bool signed_difference = false;
 };
 
 void run_compare(const CompareArguments& args) {
@@ -35,6 +37,14 @@ void run_compare(const CompareArguments& args) {
     const auto mask = render::nonzero_mask(reference);
     for (std::size_t p = 0; p < mask.size(); ++p) {
       if (!mask[p]) continue;
+      if (args.signed_difference) {  // red: the image is brighter; blue: darker (mean of RGB)
+        double delta = 0;
+        for (int c = 0; c < 3; ++c) delta += image.data[3 * p + std::size_t(c)] - reference.data[3 * p + std::size_t(c)];
+        delta /= 3 * d.reference_mean;
+        diff.data[3 * p] = float(std::max(0.0, delta));
+        diff.data[3 * p + 2] = float(std::max(0.0, -delta));
+        continue;
+      }
       for (int c = 0; c < 3; ++c) {
         const std::size_t i = 3 * p + std::size_t(c);
         diff.data[i] = float(std::abs(image.data[i] - reference.data[i]) / d.reference_mean);
@@ -74,6 +84,8 @@ void register_compare_command(CLI::App& app) {
   cmd->add_flag("--json", args->json, "print a JSON summary (lucent-image-difference)");
   cmd->add_option("--difference", args->difference,
                   "also write |image - reference| / the reference's mean as an image (.png or .exr)");
+  cmd->add_flag("--signed", args->signed_difference,
+               "--difference: red where the image is brighter, blue where darker");
   cmd->add_option("--scale", args->scale, "--difference: multiplier before the tone curve")
       ->capture_default_str();
   cmd->callback([args] { run_compare(*args); });

@@ -62,6 +62,9 @@ void run_render(RenderArguments& render_args) {
   const bool show_progress = ::isatty(STDERR_FILENO) != 0;
   ImageRgb image;
   RenderStats stats;
+  if (args.technique == "reference" && !render_args.snapshots.empty()) {
+    throw Error("--snapshots: frame snapshots are of the radiance maps (--technique maps)");
+  }
   if (args.technique == "reference") {
     if (show_progress) args.reference.progress = print_progress;
     ReferenceImage result = render_reference(scene, args.settings.model, args.reference);

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.h"
+#include "lucent/acquire/image_io.h"
 
 namespace lucent::testing {
 namespace {
@@ -18,7 +19,7 @@ namespace fs = std::filesystem;
 
 // A tiny, fast reference render; append the case's own options.
 const std::string kTiny =
-    "render --technique reference --size 24x20 --samples-reference 2000 --threads 2 "
+    "render --technique reference --size 24x20 --samples-pixel 64 --threads 2 "
     "--view 30,20,4 ";
 
 void write_text(const fs::path& path, const std::string& text) {
@@ -50,6 +51,12 @@ TEST(RenderCommand, ReferenceToPngWithStats) {
   EXPECT_TRUE(r.err.empty()) << r.err;
   ASSERT_TRUE(fs::exists(out));
   EXPECT_EQ(read_prefix(out, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  // One line on stdout says what was written, how, and in how long.
+  EXPECT_EQ(lines(r.out), 1) << r.out;
+  EXPECT_NE(r.out.find("wrote " + out.string()), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("CPU reference"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("exposure"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(auto)"), std::string::npos) << r.out;
   const auto doc = nlohmann::json::parse(read_text(stats));
   EXPECT_EQ(doc.at("format"), "lucent-render-stats");
   EXPECT_EQ(doc.at("version"), 1);
@@ -148,7 +155,15 @@ INSTANTIATE_TEST_SUITE_P(
                 "no triangles"},
         BadCase{"missing_material", "--material unobtainium --light directional:0,0,1:1,1,1",
                 "unobtainium"},
-        BadCase{"no_light", "--material marble", "no light"},
+        BadCase{"bad_exposure", "--material marble --exposure bright", "--exposure"},
+        BadCase{"negative_exposure", "--material marble --exposure -2", "--exposure"},
+        BadCase{"bad_roughness", "--material marble --roughness 3", "--roughness"},
+        BadCase{"bad_specular", "--material marble --specular maybe", "--specular"},
+        BadCase{"bad_backdrop", "--material marble --backdrop 1,2", "--backdrop"},
+        BadCase{"bad_reference_sampling", "--material marble --reference-sampling grid",
+                "--reference-sampling"},
+        BadCase{"snapshot_of_the_reference",
+                "--material marble --light directional:0,0,1:1,1,1 --snapshots 1", "--snapshots"},
         BadCase{"zero_size", "--material marble --light directional:0,0,1:1,1,1 --size 0x0",
                 "--size"},
         BadCase{"bad_size", "--material marble --light directional:0,0,1:1,1,1 --size 64",
@@ -177,6 +192,65 @@ TEST(RenderCommand, UnsupportedOutputFormatFails) {
   EXPECT_NE(r.exit_code, 0);
   EXPECT_EQ(lines(r.err), 1) << r.err;
   EXPECT_FALSE(fs::exists(out));
+  fs::remove_all(dir);
+}
+
+// No --light and no --env: the default rig (key, fill, rim), named on stderr; the image is lit.
+// --exposure auto puts the object's bright side near the top of the tone curve without clipping;
+// a fixed exposure of 1 leaves this scene darker.
+TEST(RenderCommand, DefaultRigAndAutoExposure) {
+  const auto dir = scratch_dir("render-rig");
+  const fs::path automatic = dir / "auto.exr", png = dir / "auto.png", dim = dir / "dim.png";
+  auto r = run_lucent(kTiny + "--material marble -o \"" + png.string() + "\"", "rig");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("default rig"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("--light directional:"), std::string::npos) << r.err;
+  r = run_lucent(kTiny + "--material marble --exposure 1 -o \"" + dim.string() + "\"", "dim");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto bright = acquire::read_raw_image(png), dark = acquire::read_raw_image(dim);
+  ASSERT_EQ(bright.max_value, 255);
+  double sum_bright = 0, sum_dark = 0;
+  int max_bright = 0;
+  for (std::size_t i = 0; i < bright.data.size(); ++i) {
+    sum_bright += bright.data[i];
+    sum_dark += dark.data[i];
+    max_bright = std::max<int>(max_bright, bright.data[i]);
+  }
+  // Auto picks ~5.8 here: through the tone curve and sRGB the pixel sum grows 1.67-fold.
+  EXPECT_GT(sum_bright, 1.3 * sum_dark);
+  EXPECT_LT(max_bright, 255);  // Reinhard never clips
+  EXPECT_GT(max_bright, 180);
+  fs::remove_all(dir);
+}
+
+// --snapshots writes the maps' linear image after the frames named; `lucent compare` measures
+// them against the final image: the difference falls as frames accumulate, and an image compared
+// with itself differs by nothing.
+TEST(RenderCommand, SnapshotsAndCompare) {
+  const auto dir = scratch_dir("render-snapshots");
+  const fs::path out = dir / "maps.exr";
+  auto r = run_lucent(
+      "render --material marble --mesh sphere --size 24x24 --frames 8 --directions 4 --samples 8 "
+      "--disc-points 64 --radiance-map 32 --light-map 32 --light directional:1,0,1:1,1,1 "
+      "--snapshots 1,4,8 -o \"" + out.string() + "\"",
+      "snapshots");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (int t : {1, 4, 8}) ASSERT_TRUE(fs::exists(dir / ("maps.f" + std::to_string(t) + ".exr"))) << t;
+  const auto difference = [&](const std::string& name) {
+    const auto c = run_lucent("compare \"" + (dir / name).string() + "\" \"" + out.string() + "\" --json",
+                              "compare-" + name);
+    EXPECT_EQ(c.exit_code, 0) << c.err;
+    return nlohmann::json::parse(c.out).at("relative_rmse").get<double>();
+  };
+  const double first = difference("maps.f1.exr"), last = difference("maps.f8.exr");
+  EXPECT_GT(first, 0);
+  EXPECT_EQ(last, 0);  // frame 8 of 8 is the final image
+  EXPECT_LE(difference("maps.f4.exr"), first);
+  const auto bad = run_lucent("compare \"" + out.string() + "\" \"" + (dir / "none.exr").string() + "\"",
+                              "compare-missing");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_EQ(lines(bad.err), 1) << bad.err;
   fs::remove_all(dir);
 }
 
