@@ -73,6 +73,7 @@ void run_render(RenderArguments& render_args) {
     stats = std::move(result.stats);
   } else {
     RadianceMapOptions options;
+    options.max_blur_level = args.max_blur;
     for (int t : render_args.snapshots) {
       if (t < 1 || t > args.settings.frames) {
         throw Error("--snapshots: frames must be 1.." + std::to_string(args.settings.frames) +

@@ -85,8 +85,9 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
                   "sampling noise)")
       ->capture_default_str();
   cmd->add_option("--model", args->model,
-                  "ddipole (directional dipole) or dipole (standard dipole); default: the "
-                  "material's fitted model, else ddipole");
+                  "tabulated (exact to Monte Carlo transport), ddipole (directional dipole) or "
+                  "dipole (standard dipole); default: the material's fitted model, else tabulated "
+                  "where the transport table covers the material, else ddipole");
   cmd->add_option("--view", args->view,
                   "AZ,EL,DIST: camera azimuth about +y from +z (degrees), elevation (degrees), "
                   "distance from the centre in bounding-sphere radii; field of view 35 degrees")
@@ -153,6 +154,10 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
                   "strata, a new one every frame: converges to all M after M/N frames) or nearest "
                   "(seed 003: the N nearest, every frame; misses the far profile)")
       ->capture_default_str();
+  cmd->add_option("--max-blur", args->max_blur,
+                  "maps: mip blur levels at the first frame, fewer as frames accumulate (0 = none; "
+                  "-1: none with the profile disc, 2 with the exponential one)")
+      ->capture_default_str();
   cmd->add_option("--radiance-map", args->settings.radiance_map_size,
                   "maps: W_s, radiance-map size in texels")
       ->capture_default_str();
@@ -191,6 +196,7 @@ SceneSetup build_scene(SceneArguments& args) {
                 "'");
   }
   if (args.reference.pixel_samples < 1) throw Error("--samples-pixel: must be at least 1");
+  if (args.max_blur < -1 || args.max_blur > 8) throw Error("--max-blur: must be -1..8");
   args.settings.validate();
   if (args.exposure == "auto") {
     args.auto_exposure = true;
@@ -239,8 +245,21 @@ SceneSetup build_scene(SceneArguments& args) {
 
   Scene scene;
   scene.material = materials::load_material(args.material);
-  const std::string model_name =
-      !args.model.empty() ? args.model : scene.material.diffusion_model("ddipole");
+  std::string model_name = !args.model.empty() ? args.model : scene.material.diffusion_model("");
+  if (model_name.empty()) {
+    // A material that was not fitted: the model exact to transport where the table reaches it
+    // (eta and every channel's g inside it), else the directional dipole. (The ddipole has no
+    // albedo factor: at low albedo it is several times too bright, and ketchup looks pink.)
+    model_name = "tabulated";
+    try {
+      for (int c = 0; c < 3; ++c) {
+        materials::radial_profile_value(scene.material, c, DiffusionModel::kTabulated,
+                                        materials::TableQuantity::kRadiance, 1.0);
+      }
+    } catch (const Error&) {
+      model_name = "ddipole";
+    }
+  }
   args.settings.model = materials::parse_diffusion_model(model_name, "--model", true);
   scene.mesh = load_mesh(args.mesh, args.object_size_mm);
   scene.lights = lights;

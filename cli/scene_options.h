@@ -32,6 +32,7 @@ struct SceneArguments {
   float roughness = 0.1f;
   std::string specular = "on";
   std::string backdrop;           ///< R,G,B radiance; empty: black
+  int max_blur = -1;              ///< maps: RadianceMapOptions::max_blur_level (-1 automatic)
   std::vector<std::string> default_rig;  ///< set by build_scene: the lights used when none given
   render::RenderSettings settings;
   render::ReferenceOptions reference;

@@ -197,7 +197,10 @@ void RadianceMapRenderer::Impl::build(const Scene& s, const RenderSettings& rs,
     throw Error("--light: the radiance maps take at most " + std::to_string(kMaxLights) +
                 " lights, got " + std::to_string(scene.lights.size()));
   }
-  if (options.max_blur_level < 0) throw Error("radiance maps: max_blur_level must be >= 0");
+  if (options.max_blur_level < -1) throw Error("--max-blur: must be >= 0 (or -1: automatic)");
+  if (options.max_blur_level < 0) {
+    options.max_blur_level = settings.disc_distribution == DiscDistribution::kProfile ? 0 : 2;
+  }
   K = settings.directions;
   L = int(scene.lights.size());
   GLint max_block = 0;

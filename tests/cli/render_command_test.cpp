@@ -63,7 +63,7 @@ TEST(RenderCommand, ReferenceToPngWithStats) {
   EXPECT_EQ(doc.at("technique"), "reference");
   EXPECT_EQ(doc.at("width"), 24);
   EXPECT_EQ(doc.at("height"), 20);
-  EXPECT_EQ(doc.at("scene").at("model"), "ddipole");  // the default for a material without one
+  EXPECT_EQ(doc.at("scene").at("model"), "tabulated");  // an unfitted material inside the table
   EXPECT_GT(doc.at("total_ms").get<double>(), 0);
   fs::remove_all(dir);
 }
