@@ -24,7 +24,7 @@ bool have_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 
 // Tiny settings: llvmpipe renders a 64-texel, 8-direction frame in ~0.1 s.
 const std::string kTiny =
     " --mesh sphere --size 200x150 --frames 8 --directions 8 --samples 8 --disc-points 32"
-    " --radiance-map 64 --light-map 64 --samples-reference 4000 --threads 2";
+    " --radiance-map 64 --light-map 64 --samples-pixel 32 --threads 2";
 
 struct Shot {
   acquire::RawImage image;
