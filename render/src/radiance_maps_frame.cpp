@@ -1,0 +1,213 @@
+// The radiance maps' frame-by-frame API (radiance_maps.h): scene changes, frames, read-back,
+// and render_radiance_maps.
+#include "radiance_maps_impl.h"
+
+#include <algorithm>
+
+namespace lucent::render {
+
+void RadianceMapRenderer::set_camera(const Camera& camera) {
+  if (camera.width != impl_->final_width || camera.height != impl_->final_height) {
+    impl_->scene.camera = camera;
+    impl_->build_final();
+  }
+  impl_->scene.camera = camera;
+}
+
+void RadianceMapRenderer::set_lights(const std::vector<Light>& lights) {
+  if (lights.empty() || int(lights.size()) > kMaxLights) {
+    throw Error("--light: the radiance maps take 1 to " + std::to_string(kMaxLights) + " lights");
+  }
+  const bool resize = int(lights.size()) != impl_->L;
+  impl_->scene.lights = lights;
+  impl_->L = int(lights.size());
+  if (resize) impl_->build_light_maps();
+  impl_->upload_lights();
+  restart();
+}
+
+void RadianceMapRenderer::set_geometry(const std::vector<Vec3f>& positions,
+                                       const std::vector<Vec3f>& normals) {
+  Impl& m = *impl_;
+  if (positions.size() != m.scene.mesh.positions.size() ||
+      normals.size() != m.scene.mesh.positions.size()) {
+    throw Error("radiance maps: a deformed mesh must keep its " +
+                std::to_string(m.scene.mesh.positions.size()) + " vertices (got " +
+                std::to_string(positions.size()) + " positions, " + std::to_string(normals.size()) +
+                " normals)");
+  }
+  m.scene.mesh.positions = positions;
+  m.scene.mesh.normals = normals;
+  glNamedBufferSubData(m.positions.id(), 0, GLsizeiptr(positions.size() * sizeof(Vec3f)),
+                       positions.data());
+  glNamedBufferSubData(m.normals.id(), 0, GLsizeiptr(normals.size() * sizeof(Vec3f)),
+                       normals.data());
+  // Nothing is precomputed per mesh beyond what depends on its bounds: the layer and light cameras
+  // are refitted, the radiance maps' depth pre-pass redone, and accumulation restarts.
+  m.centre = m.scene.mesh.centre();
+  m.radius_mm = m.scene.mesh.bounding_radius();
+  m.upload_layers();
+  m.upload_lights();
+  m.render_radiance_depth();
+  restart();
+}
+
+void RadianceMapRenderer::set_material(const materials::Material& material) {
+  impl_->scene.material = material;
+  impl_->upload_material();
+  restart();
+}
+
+void RadianceMapRenderer::restart() {
+  Impl& m = *impl_;
+  m.frame = 0;
+  m.level = 0;
+  m.light_map_valid = false;
+  m.last_image.clear();
+  const std::string renderer = m.stats.gl_renderer;
+  const double setup = m.stats.setup_ms;
+  const RadianceMapStats disc_stats = m.stats;
+  m.stats = RadianceMapStats{};
+  m.stats.gl_renderer = renderer;
+  m.stats.setup_ms = setup;
+  m.stats.sigma_star_per_mm = disc_stats.sigma_star_per_mm;
+  m.stats.disc_radius_mm = disc_stats.disc_radius_mm;
+  m.stats.used_disc_radius_mm = disc_stats.used_disc_radius_mm;
+  m.stats.samples_per_light = disc_stats.samples_per_light;
+}
+
+bool RadianceMapRenderer::render_frame() {
+  Impl& m = *impl_;
+  if (!m.light_map_valid) {
+    m.timed(kLightMap, [&] { m.render_light_map(); });
+    m.light_map_valid = true;
+    ++m.stats.light_map_renders;
+  }
+  const bool accumulate = m.frame < m.settings.frames;
+  if (accumulate) {
+    ++m.frame;
+    m.timed(kRadianceMap, [&] { m.render_radiance(); });
+    m.level = detail::blur_level_for_frame(m.frame, m.settings.frames,
+                                           std::min(m.options.max_blur_level, m.levels - 1));
+    m.timed(kMipBlur, [&] { m.render_blur(); });
+    m.stats.frames = m.frame;
+  }
+  m.timed(kFinal, [&] { m.render_final(); });
+  ++m.stats.frames_rendered;
+  if (accumulate && m.options.convergence_tolerance > 0) m.record_convergence();
+  gl::check_errors("a radiance-map frame");
+  return accumulate;
+}
+
+int RadianceMapRenderer::accumulated_frames() const {
+  return impl_->frame;
+}
+
+bool RadianceMapRenderer::converged() const {
+  return impl_->frame >= impl_->settings.frames;
+}
+
+ImageRgb RadianceMapRenderer::read_image() const {
+  const Impl& m = *impl_;
+  const std::vector<float> rgba = m.read_rgba();
+  ImageRgb image(m.final_width, m.final_height);
+  for (int y = 0; y < m.final_height; ++y) {
+    const int row = m.final_height - 1 - y;  // GL rows go up from the bottom
+    for (int x = 0; x < m.final_width; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        image.at(x, y, c) = rgba[(std::size_t(row) * m.final_width + x) * 4 + std::size_t(c)];
+      }
+    }
+  }
+  return image;
+}
+
+std::vector<std::uint8_t> RadianceMapRenderer::read_mask() const {
+  const Impl& m = *impl_;
+  const std::vector<float> rgba = m.read_rgba();
+  std::vector<std::uint8_t> mask(std::size_t(m.final_width) * m.final_height);
+  for (int y = 0; y < m.final_height; ++y) {
+    const int row = m.final_height - 1 - y;
+    for (int x = 0; x < m.final_width; ++x) {
+      mask[std::size_t(y) * m.final_width + x] =
+          rgba[(std::size_t(row) * m.final_width + x) * 4 + 3] > 0 ? 1 : 0;
+    }
+  }
+  return mask;
+}
+
+void RadianceMapRenderer::present(float exposure, int width, int height) const {
+  const Impl& m = *impl_;
+  glViewport(0, 0, width, height);
+  glDisable(GL_DEPTH_TEST);
+  m.present_program.use();
+  glUniform1f(m.present_program.location("u_exposure"), exposure);
+  glBindTextureUnit(0, m.final_color.id());
+  glBindSampler(0, m.linear_clamp.id());
+  glBindVertexArray(m.empty_vao.id());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+const RadianceMapStats& RadianceMapRenderer::stats() const {
+  return impl_->stats;
+}
+
+ImageRgb render_radiance_maps(const Scene& scene, const RenderSettings& settings,
+                              RenderStats* stats) {
+  return render_radiance_maps(scene, settings, RadianceMapOptions{}, stats, nullptr);
+}
+
+ImageRgb render_radiance_maps(const Scene& scene, const RenderSettings& settings,
+                              const RadianceMapOptions& options, RenderStats* stats,
+                              RadianceMapStats* details) {
+  const double t0 = now_ms();
+  const auto context = GlContext::create_headless();
+  RadianceMapRenderer renderer;
+  renderer.setup(scene, settings, options);
+  while (renderer.render_frame()) {
+    const int t = renderer.accumulated_frames();
+    if (options.on_snapshot && std::find(options.snapshot_frames.begin(),
+                                         options.snapshot_frames.end(), t) !=
+                                   options.snapshot_frames.end()) {
+      options.on_snapshot(t, renderer.read_image());
+    }
+  }
+  ImageRgb image = renderer.read_image();
+  const RadianceMapStats& s = renderer.stats();
+  if (details != nullptr) *details = s;
+  if (stats != nullptr) {
+    const StageTimes wall = s.mean_wall(), gpu = s.mean_gpu();
+    stats->technique = "maps";
+    stats->width = scene.camera.width;
+    stats->height = scene.camera.height;
+    stats->total_ms = now_ms() - t0;
+    stats->pass_ms = {{"setup", s.setup_ms},
+                      {"light map", wall.light_map_ms},
+                      {"radiance map", wall.radiance_map_ms},
+                      {"mip blur", wall.mip_blur_ms},
+                      {"final", wall.final_ms}};
+    stats->details = {
+        {"gl_renderer", s.gl_renderer},
+        {"timing", options.time_stages ? "per-frame means, glFinish + wall clock"
+                                       : "per-frame means, wall clock without glFinish"},
+        {"gpu_query_ms",
+         {{"light map", gpu.light_map_ms},
+          {"radiance map", gpu.radiance_map_ms},
+          {"mip blur", gpu.mip_blur_ms},
+          {"final", gpu.final_ms}}},
+        {"frames", s.frames},
+        {"convergence_frame", s.convergence_frame},
+        {"convergence_tolerance", options.convergence_tolerance},
+        {"frame_change", s.frame_change},
+        {"uncovered_fraction", s.uncovered_fraction},
+        {"sigma_star_per_mm", s.sigma_star_per_mm},
+        {"disc_radius_mm", s.disc_radius_mm},
+        {"used_disc_radius_mm", s.used_disc_radius_mm},
+        {"samples_per_light", s.samples_per_light},
+        {"settings", settings.to_string()},
+        {"options", options.to_string()}};
+  }
+  return image;
+}
+
+}  // namespace lucent::render
