@@ -122,17 +122,9 @@ class RayScene {
   /// none.
   bool intersect(const Vec3f& origin, const Vec3f& direction, unsigned& triangle, float& u,
                  float& v) const {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    RTCRayHit rh{};
-    set_ray(rh.ray, origin, direction, kInf);
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(scene_, &context, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-    triangle = rh.hit.primID;
-    u = rh.hit.u;
-    v = rh.hit.v;
-    return true;
+    float t = 0;
+    return intersect_segment(origin, direction, 0.0f, std::numeric_limits<float>::infinity(),
+                             triangle, u, v, t);
   }
 
   /// Nearest hit along the ray in (t_near, t_far): triangle, barycentrics and distance t.
@@ -215,6 +207,24 @@ class ChannelBssrdf {
   std::shared_ptr<const materials::TabulatedModel<double>> tabulated_;
   double tabulated_scale_ = 0;
 };
+
+/// The direction w from x toward a light, the falloff 1 / distance^2 of a point light (1 for a
+/// directional one) and the distance (infinite for a directional light); false at the light.
+inline bool toward_light(const Light& light, const Vec3f& x, Vec3f& w, double& falloff,
+                         double& distance) {
+  falloff = 1;
+  distance = kInf;
+  if (light.type == LightType::kDirectional) {
+    w = light.direction.normalized();
+    return true;
+  }
+  const Vec3f to_light = light.position - x;
+  distance = to_light.norm();
+  if (!(distance > 0)) return false;
+  w = to_light / float(distance);
+  falloff = 1.0 / (distance * distance);
+  return true;
+}
 
 struct PixelHit {
   Vec3f x_o, n_o;

@@ -144,15 +144,7 @@ void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions
               for (const Light& light : scene.lights) {
                 Vec3f w;
                 double scale = 1, distance = kInf;
-                if (light.type == LightType::kDirectional) {
-                  w = light.direction.normalized();
-                } else {
-                  const Vec3f to_light = light.position - x_f;
-                  distance = to_light.norm();
-                  if (!(distance > 0)) continue;
-                  w = to_light / float(distance);
-                  scale = 1.0 / (distance * distance);
-                }
+                if (!toward_light(light, x_f, w, scale, distance)) continue;
                 const double cos_i = n_f.dot(w);
                 if (!(cos_i > 0)) continue;
                 if (options.shadows) {

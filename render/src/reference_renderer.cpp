@@ -156,15 +156,7 @@ Vec3f specular_radiance(const Scene& scene, const RayScene& rays, const PixelHit
   for (const Light& light : scene.lights) {
     Vec3f w;
     double scale = 1, distance = kInf;
-    if (light.type == LightType::kDirectional) {
-      w = light.direction.normalized();
-    } else {
-      const Vec3f to_light = light.position - hit.x_o;
-      distance = to_light.norm();
-      if (!(distance > 0)) continue;
-      w = to_light / float(distance);
-      scale = 1.0 / (distance * distance);
-    }
+    if (!toward_light(light, hit.x_o, w, scale, distance)) continue;
     const double cos_i = hit.n_o.dot(w);
     if (!(cos_i > 0)) continue;
     const Vec3f offset = hit.g_o.dot(w) >= 0 ? hit.g_o : Vec3f(-hit.g_o);
@@ -501,15 +493,7 @@ ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
             const Light& light = scene.lights[l];
             Vec3f w;
             double irradiance_scale = 1, distance = kInf;
-            if (light.type == LightType::kDirectional) {
-              w = light.direction.normalized();
-            } else {
-              const Vec3f to_light = light.position - xs[k];
-              distance = to_light.norm();
-              if (!(distance > 0)) continue;
-              w = to_light / float(distance);
-              irradiance_scale = 1.0 / (distance * distance);
-            }
+            if (!toward_light(light, xs[k], w, irradiance_scale, distance)) continue;
             const double cos_i = ns[k].dot(w);
             if (!(cos_i > 0)) continue;
             if (options.shadows) {
