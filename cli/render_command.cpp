@@ -5,8 +5,10 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -96,9 +98,9 @@ void run_render(RenderArguments& render_args) {
                       {"lucent:technique", args.technique}});
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const bool png = render_args.output.size() >= 4 &&
-                   render_args.output.substr(render_args.output.size() - 4) != ".exr" &&
-                   render_args.output.substr(render_args.output.size() - 4) != ".EXR";
+  std::string extension = std::filesystem::path(render_args.output).extension().string();
+  for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+  const bool png = extension == ".png";  // EXR is written linear, without the exposure
   std::printf("render: wrote %s (%dx%d, %s, %s on %s, %s%s) in %.1f s\n", render_args.output.c_str(),
               scene.camera.width, scene.camera.height,
               args.technique == "maps" ? "radiance maps" : "CPU reference",

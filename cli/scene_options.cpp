@@ -245,22 +245,9 @@ SceneSetup build_scene(SceneArguments& args) {
 
   Scene scene;
   scene.material = materials::load_material(args.material);
-  std::string model_name = !args.model.empty() ? args.model : scene.material.diffusion_model("");
-  if (model_name.empty()) {
-    // A material that was not fitted: the model exact to transport where the table reaches it
-    // (eta and every channel's g inside it), else the directional dipole. (The ddipole has no
-    // albedo factor: at low albedo it is several times too bright, and ketchup looks pink.)
-    model_name = "tabulated";
-    try {
-      for (int c = 0; c < 3; ++c) {
-        materials::radial_profile_value(scene.material, c, DiffusionModel::kTabulated,
-                                        materials::TableQuantity::kRadiance, 1.0);
-      }
-    } catch (const Error&) {
-      model_name = "ddipole";
-    }
-  }
-  args.settings.model = materials::parse_diffusion_model(model_name, "--model", true);
+  args.settings.model = !args.model.empty()
+                            ? materials::parse_diffusion_model(args.model, "--model", true)
+                            : materials::preferred_model(scene.material);
   scene.mesh = load_mesh(args.mesh, args.object_size_mm);
   scene.lights = lights;
   if (env) {

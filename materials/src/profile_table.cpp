@@ -88,6 +88,19 @@ const TabulatedProfile& tabulated_profile_for(double g) {
   return *cached_tabulated_profile(default_transport_table(), g);
 }
 
+DiffusionModel preferred_model(const Material& material) {
+  const std::string fitted = material.diffusion_model("");
+  if (!fitted.empty()) return parse_diffusion_model(fitted, "model", true);
+  try {
+    for (int c = 0; c < 3; ++c) {
+      radial_profile_value(material, c, DiffusionModel::kTabulated, TableQuantity::kRadiance, 1.0);
+    }
+    return DiffusionModel::kTabulated;
+  } catch (const Error&) {
+    return DiffusionModel::kDirectionalDipole;  // eta or g outside the table
+  }
+}
+
 std::vector<double> parse_radius_list(const std::string& text, const std::string& option) {
   std::vector<double> radii;
   for (const std::string& field : split(text, ',')) {

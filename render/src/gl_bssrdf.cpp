@@ -28,23 +28,19 @@ DipoleChannelData dipole_channel_data(const materials::Medium<double>& medium) {
 TabulatedChannelData tabulated_channel_data(const materials::Medium<double>& medium, int row) {
   const auto profile = materials::cached_tabulated_profile(materials::default_transport_table(),
                                                            medium.g, medium.eta);
+  const materials::TabulatedModel<double> model(*profile, medium);
   const std::vector<double>& x = profile->log_rho_nodes();
   TabulatedChannelData d;
   d.nodes = int(x.size());
   d.row = row;
   d.x0 = float(x.front());
   d.h = float(x[1] - x[0]);
-  const double sigma_t = medium.sigma_a + medium.sigma_s * (1 - medium.g);
-  const double alpha = sigma_t > 0 ? medium.sigma_s * (1 - medium.g) / sigma_t : 0;
-  d.sigma_t = float(sigma_t);
+  d.sigma_t = float(model.sigma_t_reduced());
   d.log_values.assign(x.size(), 0.0f);
-  if (!(alpha > 0)) return d;  // scale 0: no subsurface light
-  std::array<std::vector<double>, materials::kTableQuantities> rows;
-  profile->rows_at(std::sqrt(std::max(0.0, 1 - alpha)), medium.eta, rows);
-  const auto& values = rows[std::size_t(materials::TableQuantity::kRadiance)];
+  if (!(model.alpha_prime() > 0)) return d;  // scale 0: no subsurface light
+  const auto& values = model.log_row(materials::TableQuantity::kRadiance);
   for (std::size_t j = 0; j < x.size(); ++j) d.log_values[j] = float(values[j]);
-  d.scale = float(sigma_t * sigma_t * alpha /
-                  (std::numbers::pi * materials::fresnel_transmittance(1.0, medium.eta)));
+  d.scale = float(model.S_d_scale());
   return d;
 }
 

@@ -61,14 +61,11 @@ struct DiscPoints {
 DiscPoints exponential_disc_points(int M, double sigma_star_per_mm, double disc_radius_mm,
                                    const Eigen::Vector3d& shift = Eigen::Vector3d::Zero());
 /// The disc of DiscDistribution::kProfile: M radii at the stratified quantiles (j + s) / M of the
-/// mixture density p(r) = (1/3) sum_c 2 pi r R_c(r) / R_tot,c of the channels that scatter (R_c
-/// the model's normal-incidence radial profile, radial_profile_value, quantity radiance), on
-/// [r_lo, R] with R the smaller of disc_radius_mm and where every channel's tail beyond holds
-/// 1e-5 of it; angles 2 pi frac(j / phi + s'). (s, s') = (0.5, 0) shifted by `shift` modulo 1.
-/// Weights 1 / (M p_A(r)), p_A = p(r) / (2 pi r) the density per area: the M points are a
-/// quadrature of the disc integral of any function, exact in the limit, and for the profile
-/// itself a near-constant integrand. The density is piecewise constant in ln r on 4096 cells, so
-/// the weights are exactly the inverse of the density the radii were drawn from.
+/// channels' mean profile density p_A (RadialProfileDensity, profile_sampling.h: out to
+/// disc_radius_mm or the widest channel's reach), angles 2 pi frac(j / phi + s'), (s, s') =
+/// (0.5, 0) shifted by `shift` modulo 1; weights 1 / (M p_A(r)), the exact inverse of the density
+/// the radii were drawn from. The M points are a quadrature of the disc integral of any function,
+/// and for the profile itself a near-constant integrand.
 DiscPoints profile_disc_points(int M, const materials::Material& material,
                                materials::DiffusionModel model, double disc_radius_mm,
                                const Eigen::Vector3d& shift = Eigen::Vector3d::Zero());

@@ -184,18 +184,16 @@ class ChannelBssrdf {
       profile_ = materials::cached_tabulated_profile(materials::default_transport_table(),
                                                      medium.g, medium.eta);
       tabulated_ = std::make_shared<materials::TabulatedModel<double>>(*profile_, medium);
-      tabulated_scale_ = 1.0 / (std::numbers::pi * materials::fresnel_transmittance(1.0, medium.eta));
     }
   }
 
-  /// S_d per mm^2 per sr without Fresnel; n_i and w_i are ignored by the radial models. The
-  /// tabulated model's S_d is its pi L along the normal / (pi F_t(eta, 1)): times the outgoing
-  /// F_t it is the table's radiance along the normal (lucent profile --quantity radiance).
+  /// S_d per mm^2 per sr without Fresnel; n_i and w_i are ignored by the radial models (the
+  /// tabulated one's is TabulatedModel::S_d).
   double operator()(const Vec3d& x_i, const Vec3d& n_i, const Vec3d& w_i, const Vec3d& x_o,
                     const Vec3d& n_o) const {
     if (model_ == DiffusionModel::kDipole) return dipole_.S_d((x_o - x_i).norm());
     if (model_ == DiffusionModel::kTabulated)
-      return tabulated_scale_ * tabulated_->radiance((x_o - x_i).norm());
+      return tabulated_->S_d((x_o - x_i).norm());
     return ddipole_.S_d(x_i, n_i, w_i, x_o, n_o);
   }
 
@@ -205,7 +203,6 @@ class ChannelBssrdf {
   materials::DirectionalDipole<double> ddipole_;
   std::shared_ptr<const materials::TabulatedProfile> profile_;
   std::shared_ptr<const materials::TabulatedModel<double>> tabulated_;
-  double tabulated_scale_ = 0;
 };
 
 /// The direction w from x toward a light, the falloff 1 / distance^2 of a point light (1 for a

@@ -341,9 +341,12 @@ void Viewer::load_material(const std::string& source) {
   material_source_ = source;
   watcher_ = std::filesystem::is_regular_file(source) ? FileWatcher(source) : FileWatcher();
   message_ = "material: " + scene_.material.name;
-  if (model_from_material_ && !scene_.material.model.empty()) {
-    settings_.model = pending_.model =
-        materials::parse_diffusion_model(scene_.material.diffusion_model(), "material model", true);
+  if (model_from_material_) {
+    const DiffusionModel model = materials::preferred_model(scene_.material);
+    if (model != settings_.model) {
+      settings_.model = pending_.model = model;
+      rebuild_maps();  // the model is compiled into the maps' programs
+    }
   }
   glfwSetWindowTitle(window_,
                      ("lucent view - " + scene_.material.name + " on " + scene_.mesh.name).c_str());

@@ -478,11 +478,10 @@ void main() {
       const auto profile = materials::cached_tabulated_profile(materials::default_transport_table(),
                                                                medium.g, medium.eta);
       const materials::TabulatedModel<double> model(*profile, medium);
-      const double scale = 1.0 / (std::numbers::pi * materials::fresnel_transmittance(1.0, eta));
       std::vector<double> reference(kRadii);
       double peak = 0;
       for (int k = 0; k < kRadii; ++k) {
-        reference[std::size_t(k)] = scale * model.radiance(double(radii[std::size_t(k)]));
+        reference[std::size_t(k)] = model.S_d(double(radii[std::size_t(k)]));
         peak = std::max(peak, reference[std::size_t(k)]);
       }
       for (int k = 0; k < kRadii; ++k) {

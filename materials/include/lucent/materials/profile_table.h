@@ -23,6 +23,12 @@ DiffusionModel parse_diffusion_model(const std::string& name,
                                      bool allow_tabulated = false);
 std::string to_string(DiffusionModel model);
 
+/// The model a renderer uses for `material` unless told otherwise: the one it was fitted with;
+/// for a material that was not fitted, the tabulated model where the default transport table
+/// covers it (eta and every channel's g), else the directional dipole (which has no albedo factor:
+/// at low albedo it is several times too bright, and ketchup looks pink).
+DiffusionModel preferred_model(const Material& material);
+
 /// "0.1,0.5,1,2" -> radii in mm; each must be finite and >= 0.
 std::vector<double> parse_radius_list(const std::string& text, const std::string& option = "--r");
 /// "FROM:TO:COUNT[:lin|log]" -> COUNT radii in mm from FROM to TO inclusive (log needs FROM > 0).

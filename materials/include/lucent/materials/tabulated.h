@@ -7,10 +7,12 @@
 #include <array>
 #include <cmath>
 #include <memory>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "lucent/materials/fresnel.h"
 #include "lucent/materials/medium.h"
 #include "lucent/materials/transport_table.h"
 
@@ -308,6 +310,24 @@ class TabulatedModel {
     using std::exp;
     return scale_ * exp(profile_->row_log_value(rows_[std::size_t(q)], rho > floor ? rho : floor));
   }
+  /// S_d per mm^2 per sr without the two Fresnel transmittances, as the renderers use the model
+  /// (DESIGN §4.2): pi L along the normal / (pi F_t(eta, 1)), so that times the outgoing F_t it is
+  /// the table's radiance along the normal (`lucent profile --quantity radiance`).
+  T S_d(T r_mm) const {
+    if (!(alpha_prime_ > T(0))) return T(0);
+    const T rho = r_mm * sigma_t_reduced_;
+    const T floor(1e-12);
+    using std::exp;
+    return S_d_scale() *
+           exp(profile_->row_log_value(rows_[std::size_t(TableQuantity::kRadiance)],
+                                       rho > floor ? rho : floor));
+  }
+  /// S_d = S_d_scale() e^(row(ln rho)) with row = log_row(kRadiance): what the GLSL twin uploads.
+  T S_d_scale() const {
+    return scale_ / (T(std::numbers::pi) * fresnel_transmittance(T(1), eta_));
+  }
+  /// The model's row of log(value / (sigma_t'^2 alpha')) over TabulatedProfile::log_rho_nodes().
+  const std::vector<T>& log_row(TableQuantity q) const { return rows_[std::size_t(q)]; }
   T total_diffuse_reflectance() const {
     if (!(alpha_prime_ > T(0))) return T(0);
     return profile_->total(alpha_prime_, eta_);
