@@ -4,6 +4,7 @@
 
 #include "commands.h"
 #include "lucent/acquire/acquire.h"
+#include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
 
 namespace lucent::cli {
@@ -14,7 +15,7 @@ struct AcquireArguments {
   std::string output;
   acquire::AcquireOptions options;
   double radius_mm = 0;
-  bool json = false;
+  bool json = false, force = false;
 };
 
 }  // namespace
@@ -33,8 +34,10 @@ void register_acquire_command(CLI::App& app) {
   cmd->add_option("capture", args->capture, "capture file (JSON, \"format\": \"lucent-capture\")")
       ->required();
   cmd->add_option("-o,--output", args->output,
-                  "output folder (created; files of the same name in an existing one are replaced)")
+                  "output folder (created whole; an existing one is refused unless --force)")
       ->required();
+  cmd->add_flag("--force", args->force,
+                "replace an existing output folder whole (its other files are removed)");
   cmd->add_option("--bins", args->options.bins,
                   "number of radial bins from 0 to the radius (default 150); bins with too few "
                   "pixels are dropped")
@@ -51,6 +54,7 @@ void register_acquire_command(CLI::App& app) {
       ->check(CLI::Range(2, 1000000000));
   cmd->add_flag("--json", args->json, "print the summary as JSON on standard output");
   cmd->callback([args, radius] {
+    set_replace_folders(args->force);
     if (radius->count() > 0) args->options.radius_mm = args->radius_mm;
     const acquire::AcquireSummary summary =
         acquire::run_acquire(args->capture, args->output, args->options);

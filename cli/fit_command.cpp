@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "commands.h"
+#include "lucent/materials/json_file.h"
 #include "lucent/materials/transport_table.h"
 #include "lucent/fit/fit.h"
 #include "lucent/fit/fit_plot.h"
@@ -102,7 +103,9 @@ void run(const FitArguments& a) {
   // Everything is computed before anything is written; each file is written atomically.
   if (!a.plot.empty()) fit::write_fit_plot(a.plot, result, data.front());
   if (!a.report.empty()) {
-    write_file_atomically(a.report, fit::fit_report(result, data, options).dump(2) + "\n");
+    const nlohmann::json report = fit::fit_report(result, data, options);
+    check_finite_json(report, a.report);
+    write_file_atomically(a.report, report.dump(2) + "\n");
   }
   materials::write_material(a.output, material);
 

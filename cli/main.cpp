@@ -2,10 +2,13 @@
 #include <iostream>
 
 #include "commands.h"
+#include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
 #include "lucent/version.h"
 
 int main(int argc, char** argv) {
+  // First, before any thread starts: SIGINT/SIGTERM/SIGHUP remove this run's temporaries.
+  lucent::remove_temporaries_on_signals();
   CLI::App app{
       "lucent: measure translucent materials and show them.\n"
       "Lengths in mm, coefficients in mm^-1 unless an option says otherwise.",
@@ -22,9 +25,16 @@ int main(int argc, char** argv) {
   lucent::cli::register_view_command(app);
   lucent::cli::register_tabulate_command(app);
   lucent::cli::register_compare_command(app);
+  // `lucent SUB --version` works as the README says, on every subcommand.
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
+    sub->set_version_flag("--version", std::string("lucent ") + lucent::kVersion);
+
+  // Every output of the command is committed together at the end, or none is (atomic_file.h).
+  lucent::OutputTransaction outputs;
 
   try {
     app.parse(argc, argv);
+    outputs.commit();
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "lucent/materials/json_file.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
 #include "lucent/render/radiance_maps.h"
@@ -120,6 +121,7 @@ void run_render(RenderArguments& render_args) {
                     {"environment", args.env},
                     {"view", args.view}};
     if (args.technique == "maps") doc["settings"] = args.settings.to_string();
+    check_finite_json(doc, render_args.stats);
     write_file_atomically(render_args.stats, doc.dump(2) + "\n");
   }
 }

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "commands.h"
+#include "lucent/materials/atomic_file.h"
 #include "lucent/acquire/simulate.h"
 #include "lucent/materials/error.h"
 
@@ -24,6 +25,7 @@ struct SimulateArguments {
   bool no_noise = false;
   bool json = false;
   bool quiet = false;
+  bool force = false;
   acquire::SimulateOptions options;
 };
 
@@ -135,8 +137,11 @@ void register_simulate_command(CLI::App& app) {
       "acquire, the bracket PNGs, truth.json and truth_radiance.exr (mm^-2 sr^-1 per unit power).");
   cmd->add_option("--material", args->material, "bundled material name or material file")
       ->required();
-  cmd->add_option("-o,--output", args->output, "output folder (created; written atomically)")
+  cmd->add_option("-o,--output", args->output,
+                  "output folder (created whole; an existing one is refused unless --force)")
       ->required();
+  cmd->add_flag("--force", args->force,
+                "replace an existing output folder whole (its other files are removed)");
   cmd->add_option("--source", args->source,
                   "exit radiance from montecarlo (photon transport), or from the dipole / ddipole "
                   "model (for round trips of lucent fit)")
@@ -191,7 +196,10 @@ void register_simulate_command(CLI::App& app) {
                   "also write the radial exitance R(r) (mm^-2 per unit power) and totals as CSV");
   cmd->add_flag("--json", args->json, "print a JSON summary on stdout");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress or summary");
-  cmd->callback([args] { run(*args); });
+  cmd->callback([args] {
+    set_replace_folders(args->force);
+    run(*args);
+  });
 }
 
 }  // namespace lucent::cli

@@ -241,6 +241,7 @@ json capture_to_json(const Capture& c) {
 void write_capture(const std::filesystem::path& path, const Capture& capture) {
   // Keep "format" and "version" first for a person opening the file.
   const json doc = capture_to_json(capture);
+  check_finite_json(doc, path.string());
   std::ostringstream out;
   out << "{\n  \"format\": \"lucent-capture\",\n  \"version\": " << Capture::kFormatVersion;
   for (const auto& [key, value] : doc.items()) {

@@ -316,7 +316,9 @@ Profile read_profile(const std::filesystem::path& path) {
 
 void write_profile(const std::filesystem::path& path, const Profile& profile) {
   std::string text;
-  dump_compact(profile_to_ordered_json(profile), 0, text);
+  const auto doc = profile_to_ordered_json(profile);
+  check_finite_json(doc, path.string());
+  dump_compact(doc, 0, text);
   write_file_atomically(path, text + "\n");
 }
 

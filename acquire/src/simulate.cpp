@@ -1,3 +1,4 @@
+#include "lucent/materials/json_file.h"
 #include "lucent/acquire/simulate.h"
 
 #include <cmath>
@@ -269,6 +270,7 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
     truth["white_reference"] = white_json;
     truth["pixel_area_mm2"] = pixel_area;
   }
+  check_finite_json(truth, "truth.json");
   write_file_atomically(out.temporary() / "truth.json", truth.dump(2) + "\n");
   summary.files.push_back("truth.json");
   out.commit();

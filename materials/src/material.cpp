@@ -393,40 +393,6 @@ nlohmann::json material_to_json(const Material& material) {
 
 }  // namespace lucent::materials
 
-namespace lucent {
-
-nlohmann::json read_json_file(const std::filesystem::path& path) {
-  const std::string source = path.string();
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    throw Error(source + ": cannot open: " + std::strerror(EISDIR));
-  }
-  errno = 0;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    const int err = errno;
-    throw Error(source + ": cannot open: " + (err != 0 ? std::strerror(err) : "unknown error"));
-  }
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw Error(source + ": cannot read: " + std::strerror(errno));
-  try {
-    return nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    // e.what() is "[json.exception.parse_error.101] parse error at line L, column C: ...";
-    // the bracketed id means nothing to a user, the position does.
-    std::string what = e.what();
-    if (const auto end = what.find("] ");
-        !what.empty() && what[0] == '[' && end != std::string::npos) {
-      what.erase(0, end + 2);
-    }
-    for (char& ch : what) {
-      if (ch == '\n' || ch == '\r') ch = ' ';
-    }
-    throw Error(source + ": not valid JSON: " + what);
-  }
-}
-
-}  // namespace lucent
 
 namespace lucent::materials {
 
@@ -443,6 +409,7 @@ void write_material(const std::filesystem::path& path, const Material& material)
     const auto it = doc.find(field);
     if (it != doc.end()) ordered[std::string(field)] = nlohmann::ordered_json(*it);
   }
+  check_finite_json(ordered, path.string());
   write_file_atomically(path, ordered.dump(2) + "\n");
 }
 

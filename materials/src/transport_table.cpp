@@ -273,7 +273,7 @@ void write_transport_table(const TransportTable& t, const std::filesystem::path&
       {"payload_bytes", payload.size()},
       {"crc32", crc32(0L, reinterpret_cast<const Bytef*>(payload.data()), uInt(payload.size()))}};
   if (t.partial) h["shard"] = t.shard, h["partial_groups"] = groups;
-  write_file_atomically(path, h.dump() + "\n" + payload);
+  write_file_atomically(path, h.dump() + "\n" + payload, /*binary=*/true);
 }
 
 TransportTable read_transport_table(const std::filesystem::path& path) {

@@ -4,6 +4,8 @@
 
 #include "viewer_impl.h"
 
+#include "lucent/materials/atomic_file.h"
+
 namespace lucent::render {
 namespace viewer_detail {
 
@@ -518,6 +520,7 @@ void Viewer::screenshot(const std::filesystem::path& path) {
   }
   try {
     acquire::write_png(path, image);
+    commit_pending_outputs();  // a screenshot appears when taken, not when the viewer closes
     ++screenshots_;
     message_ = "wrote " + path.string();
     std::printf("view: wrote %s (%dx%d, frame %d of %d)\n", path.string().c_str(), width_, height_,

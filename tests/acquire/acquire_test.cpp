@@ -21,6 +21,7 @@
 #include "lucent/acquire/hdr_merge.h"
 #include "lucent/acquire/image_io.h"
 #include "lucent/acquire/profile.h"
+#include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
 
 namespace lucent::acquire {
@@ -899,15 +900,21 @@ TEST(Acquire, ObliqueCaptureWritesTwoDimensionalSamples) {
   }
 }
 
-TEST(Acquire, ExistingOutputFolderKeepsOtherFiles) {
+TEST(Acquire, ExistingOutputFolderIsReplacedWholeOnlyWhenAllowed) {
   const SyntheticCapture s = make_synthetic("acquire-existing", false);
   const fs::path out = s.dir / "out";
   fs::create_directories(out);
   std::ofstream(out / "notes.txt") << "mine";
   std::ofstream(out / "profile.csv") << "old";
+  // Refused by default: the folder is left exactly as it was.
+  EXPECT_THROW(run_acquire(s.capture, out), Error);
+  EXPECT_EQ(listing(out), (std::set<std::string>{"notes.txt", "profile.csv"}));
+  // Allowed (the CLI's --force): replaced whole, no stale file of the earlier folder survives.
+  set_replace_folders(true);
   run_acquire(s.capture, out);
-  EXPECT_EQ(listing(out), (std::set<std::string>{"acquire.png", "capture.exr", "notes.txt",
-                                                 "profile.csv", "profile.json"}));
+  set_replace_folders(false);
+  EXPECT_EQ(listing(out),
+            (std::set<std::string>{"acquire.png", "capture.exr", "profile.csv", "profile.json"}));
   std::ifstream csv(out / "profile.csv");
   std::string header;
   std::getline(csv, header);
@@ -1021,8 +1028,10 @@ TEST(AcquireBadInput, FailureLeavesAnExistingOutputFolderUnchanged) {
   fs::create_directories(out);
   std::ofstream(out / "profile.json") << "{\"keep\": true}";
   const ImageSet set = write_brackets(dir, "b", ImageRgb(64, 64, 0.0f), StackSpec{});
+  set_replace_folders(true);  // allowed to replace it, but the run fails: the folder must survive
   expect_acquire_fails(write_capture_file(dir, make_capture(set, 0.1, Response::kLinear)), out,
                        {"all-black"});
+  set_replace_folders(false);
   std::ifstream in(out / "profile.json");
   std::string text;
   std::getline(in, text);

@@ -61,8 +61,13 @@ TEST(AcquireCommand, WritesTheOutputFolderAndASummary) {
   EXPECT_EQ(summary["calibrated"], false);
   EXPECT_GT(summary["bins_written"].get<int>(), 10);
 
-  const auto human = run_lucent("acquire \"" + capture.string() + "\" -o \"" + out.string() + "\"",
-                                "acquire-human");
+  const auto again = run_lucent("acquire \"" + capture.string() + "\" -o \"" + out.string() + "\"",
+                                "acquire-again");
+  EXPECT_EQ(again.exit_code, 1);  // the folder exists: refused without --force, one line
+  EXPECT_NE(again.err.find("--force"), std::string::npos) << again.err;
+  EXPECT_EQ(lines(again.err), 1) << again.err;
+  const auto human = run_lucent(
+      "acquire \"" + capture.string() + "\" -o \"" + out.string() + "\" --force", "acquire-human");
   ASSERT_EQ(human.exit_code, 0) << human.err;
   EXPECT_NE(human.out.find("entry point"), std::string::npos) << human.out;
   EXPECT_NE(human.out.find("relative"), std::string::npos) << human.out;

@@ -1,5 +1,15 @@
-// Atomic output: write to a temporary file beside the target, rename over it when complete, so a
-// failed run never leaves a partial file behind.
+// Atomic output (DESIGN §2): every file and folder a run writes appears whole or not at all.
+//
+// Each output is first written to a hidden temporary beside its target (`.NAME.tmp-PID-N[.ext]`,
+// same file system, so rename(2) is atomic). Without an OutputTransaction each output is renamed
+// into place when it is complete. Inside one (every CLI command runs in one), the renames wait for
+// OutputTransaction::commit(), which makes them all (backing up replaced targets and restoring them
+// if any rename fails): a command that fails, throws, or is stopped by SIGINT/SIGTERM/SIGHUP leaves
+// none of its outputs and none of its temporaries. Temporaries left by a process that was killed
+// (SIGKILL) are removed the next time lucent writes into that folder.
+//
+// Inputs are protected too: readers record what they read (note_input), and an output that would
+// replace a recorded input, or a folder holding one, is refused.
 #pragma once
 
 #include <filesystem>
@@ -8,13 +18,21 @@
 
 namespace lucent {
 
-/// Writes `content` to `path` atomically (temporary file in the same folder + rename).
-/// Throws lucent::Error naming the path when it cannot.
-void write_file_atomically(const std::filesystem::path& path, std::string_view content);
+/// Records that this run read `path` (readers call it) while an OutputTransaction is open. Outputs
+/// that name the same file, or an output folder that holds it, are then refused (lucent::Error).
+void note_input(const std::filesystem::path& path);
+
+/// Throws lucent::Error if writing `target` would replace an input this run read.
+void check_not_an_input(const std::filesystem::path& target);
+
+/// Writes `content` to `path` atomically. Text (binary = false) is checked first: a "nan" or
+/// "inf" number token is refused (lucent never writes one). Throws lucent::Error naming the path.
+void write_file_atomically(const std::filesystem::path& path, std::string_view content,
+                           bool binary = false);
 
 /// For writers that need a file name (image libraries): hands out a temporary path in the target's
-/// folder; commit() renames it over the target; the destructor removes it if commit() was not
-/// called.
+/// folder; commit() renames it over the target (or hands it to the open transaction); the
+/// destructor removes it if commit() was not called.
 class AtomicOutputPath {
  public:
   explicit AtomicOutputPath(std::filesystem::path target);
@@ -34,9 +52,10 @@ class AtomicOutputPath {
 };
 
 /// An output folder that appears whole or not at all: files are written into a temporary sibling
-/// folder; commit() renames it to the target (or, when the target already exists, moves each file
-/// into it, replacing files of the same name); the destructor removes the temporary folder if
-/// commit() was not called, leaving the target exactly as it was.
+/// folder; commit() renames it to the target. A target that exists and is not empty is replaced
+/// whole, and only when the run allows it (set_replace_folders, the CLI's --force); never when it
+/// holds an input of the run. The destructor removes the temporary folder if commit() was not
+/// called, leaving the target exactly as it was.
 class AtomicOutputDir {
  public:
   explicit AtomicOutputDir(std::filesystem::path target);
@@ -54,5 +73,33 @@ class AtomicOutputDir {
   std::filesystem::path temporary_;
   bool committed_ = false;
 };
+
+/// Whether an existing, non-empty output folder may be replaced (whole). Off by default.
+void set_replace_folders(bool allow);
+
+/// All the outputs of one command as one commit. At most one is open at a time; while it is, the
+/// helpers above defer their renames to commit(). Destroyed without commit(): every temporary is
+/// removed and no target is touched.
+class OutputTransaction {
+ public:
+  OutputTransaction();
+  ~OutputTransaction();
+  OutputTransaction(const OutputTransaction&) = delete;
+  OutputTransaction& operator=(const OutputTransaction&) = delete;
+
+  /// Renames every output into place, all or none: if one rename fails the targets already
+  /// replaced are restored from their backups before the error is thrown.
+  void commit();
+};
+
+/// Commits what the open transaction holds so far (the viewer's screenshots appear at once);
+/// OutputTransaction::commit() calls it. Without a transaction there is nothing pending.
+void commit_pending_outputs();
+
+/// Blocks SIGINT, SIGTERM and SIGHUP in the calling thread (call it first in main, before any
+/// thread starts, so that every thread inherits the mask) and starts a thread that waits for them:
+/// on one it removes every temporary of this process, then lets the signal end the process as it
+/// would have (exit status 128 + signal).
+void remove_temporaries_on_signals();
 
 }  // namespace lucent

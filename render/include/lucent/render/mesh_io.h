@@ -1,0 +1,26 @@
+// Reading triangle meshes from PLY and OBJ bytes. lucent's own readers rather than Assimp's:
+// Assimp 5.2's PLY reader reads past the end of a truncated binary file (SIGSEGV), believes a
+// header's counts (std::bad_alloc at 2e9 vertices) and drops out-of-range faces without a word.
+// These check every count against the bytes that are there, every index against the vertices,
+// every coordinate for finiteness, and throw lucent::Error naming the file, element and item.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "lucent/render/scene.h"
+
+namespace lucent::render {
+
+/// PLY (ascii, binary_little_endian, binary_big_endian 1.0): element "vertex" with x, y, z (and
+/// optionally nx, ny, nz, used when every vertex has them), element "face" with a list property
+/// vertex_indices (or vertex_index); polygons are split into triangle fans; other elements and
+/// properties are skipped. Positions in the file's units (load_mesh scales them).
+Mesh parse_ply(std::string_view bytes, const std::string& source);
+
+/// Wavefront OBJ: `v x y z [w]` and `f a b c ...` (a, a/t, a/t/n or a//n; negative indices count
+/// back from the latest vertex); polygons as triangle fans. Normals (`vn`) are not read: the
+/// renderer computes area-weighted ones. Other statements are ignored.
+Mesh parse_obj(std::string_view text, const std::string& source);
+
+}  // namespace lucent::render
