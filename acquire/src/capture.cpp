@@ -128,8 +128,11 @@ std::string to_string(Response response) {
 }
 
 Capture read_capture(const std::filesystem::path& path) {
-  const std::string source = path.string();
-  const json doc = read_json_file(path);
+  return capture_from_json(read_json_file(path), path.string(), path.parent_path());
+}
+
+Capture capture_from_json(const nlohmann::json& doc, const std::string& source,
+                          const std::filesystem::path& base_dir) {
   const FieldReader in(source);
   if (!doc.is_object()) throw Error(source + ": expected a JSON object (a lucent-capture file)");
   in.only_known(
@@ -149,7 +152,7 @@ Capture read_capture(const std::filesystem::path& path) {
   }
 
   Capture c;
-  c.base_dir = path.parent_path();
+  c.base_dir = base_dir;
   c.sample = read_image_set(doc, "", in);
   if (!doc.contains("pixel_pitch_mm"))
     in.fail("pixel_pitch_mm", "missing (pixel size on the sample in mm)");

@@ -1,6 +1,7 @@
 #include "lucent/fit/fit_data.h"
 
 #include <charconv>
+#include <cstdio>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -9,6 +10,7 @@
 
 #include "lucent/acquire/profile.h"
 #include "lucent/materials/error.h"
+#include "lucent/materials/json_file.h"
 
 namespace lucent::fit {
 namespace {
@@ -17,6 +19,13 @@ std::string trim(std::string s) {
   const auto a = s.find_first_not_of(" \t\r\n");
   if (a == std::string::npos) return {};
   return s.substr(a, s.find_last_not_of(" \t\r\n") - a + 1);
+}
+
+// %g: a user sees 1e+308, not a 309-digit number.
+std::string format_number(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%g", v);
+  return buffer;
 }
 
 std::vector<std::string> split(const std::string& line) {
@@ -28,10 +37,10 @@ std::vector<std::string> split(const std::string& line) {
   return out;
 }
 
-ProfileData load_csv(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  const std::string source = path.string();
-  if (!in) throw Error(source + ": cannot open the profile");
+}  // namespace
+
+ProfileData parse_profile_csv(std::string_view text, const std::string& source) {
+  std::istringstream in{std::string(text)};
   std::string line;
   int line_number = 0;
   std::map<std::string, std::string> meta;  // key=value tokens of the leading comment lines
@@ -49,7 +58,16 @@ ProfileData load_csv(const std::filesystem::path& path) {
   }
   const std::vector<std::string> header = split(trim(line));
   std::map<std::string, int> column;
-  for (std::size_t i = 0; i < header.size(); ++i) column[header[i]] = int(i);
+  for (std::size_t i = 0; i < header.size(); ++i) {
+    if (header[i].empty()) {
+      throw Error(source + ": line " + std::to_string(line_number) + ": column " +
+                  std::to_string(i + 1) + " of the header has no name");
+    }
+    if (!column.emplace(header[i], int(i)).second) {
+      throw Error(source + ": line " + std::to_string(line_number) + ": column " + header[i] +
+                  " appears twice in the header (which one is meant?)");
+    }
+  }
   const auto has = [&](const std::string& name) { return column.count(name) > 0; };
   if (!has("r_mm")) {
     throw Error(source + ": line " + std::to_string(line_number) +
@@ -153,9 +171,16 @@ ProfileData load_csv(const std::filesystem::path& path) {
         assumed_errors = true;
       }
     }
+    const double r_inner = inner >= 0 ? number(inner) : r;
+    const double r_outer = outer >= 0 ? number(outer) : r;
+    if (!(r_inner >= 0 && r_inner <= r && r <= r_outer)) {
+      throw Error(where + "expected 0 <= r_inner_mm <= r_mm <= r_outer_mm, got " +
+                  format_number(r_inner) + ", " + format_number(r) + ", " +
+                  format_number(r_outer));
+    }
     d.radial.r_mm.push_back(r);
-    d.radial.r_inner_mm.push_back(inner >= 0 ? number(inner) : r);
-    d.radial.r_outer_mm.push_back(outer >= 0 ? number(outer) : r);
+    d.radial.r_inner_mm.push_back(r_inner);
+    d.radial.r_outer_mm.push_back(r_outer);
     for (int c = 0; c < 3; ++c) {
       d.radial.value[c].push_back(v[c]);
       d.radial.standard_error[c].push_back(se[c]);
@@ -181,10 +206,10 @@ ProfileData load_csv(const std::filesystem::path& path) {
   return d;
 }
 
-ProfileData load_json(const std::filesystem::path& path) {
-  const acquire::Profile p = acquire::read_profile(path);
+ProfileData profile_data_from_json(const nlohmann::json& doc, const std::string& source) {
+  const acquire::Profile p = acquire::profile_from_json(doc, source);
   ProfileData d;
-  d.source = path.string();
+  d.source = source;
   d.calibrated = p.calibrated;
   if (p.beam_power && p.provenance.contains("white_reference")) {
     const auto& white = p.provenance["white_reference"];
@@ -225,13 +250,11 @@ ProfileData load_json(const std::filesystem::path& path) {
   return d;
 }
 
-}  // namespace
-
 ProfileData load_profile_data(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
   for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-  if (ext == ".csv") return load_csv(path);
-  if (ext == ".json") return load_json(path);
+  if (ext == ".csv") return parse_profile_csv(read_input_file(path), path.string());
+  if (ext == ".json") return profile_data_from_json(read_json_file(path), path.string());
   throw Error(path.string() + ": expected a lucent-profile .json (from lucent acquire) or a .csv");
 }
 

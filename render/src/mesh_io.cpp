@@ -1,4 +1,4 @@
-// parse_ply and parse_obj: see mesh_io.h.
+// parse_ply and parse_obj (see mesh_io.h), and the Mesh measures (scene.h).
 #include "lucent/render/mesh_io.h"
 
 #include <algorithm>
@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -165,6 +166,39 @@ void check_finite(const Vec3f& p, const std::string& source, const std::string& 
 
 }  // namespace
 
+Vec3f Mesh::bounds_min() const {
+  Vec3f lo = Vec3f::Constant(std::numeric_limits<float>::infinity());
+  for (const Vec3f& p : positions) lo = lo.cwiseMin(p);
+  return positions.empty() ? Vec3f::Zero() : lo;
+}
+
+Vec3f Mesh::bounds_max() const {
+  Vec3f hi = Vec3f::Constant(-std::numeric_limits<float>::infinity());
+  for (const Vec3f& p : positions) hi = hi.cwiseMax(p);
+  return positions.empty() ? Vec3f::Zero() : hi;
+}
+
+Vec3f Mesh::centre() const {
+  return 0.5f * (bounds_min() + bounds_max());
+}
+
+float Mesh::bounding_radius() const {
+  const Vec3f c = centre();
+  float r2 = 0;
+  for (const Vec3f& p : positions) r2 = std::max(r2, (p - c).squaredNorm());
+  return std::sqrt(r2);
+}
+
+double Mesh::surface_area() const {
+  double area = 0;
+  for (const auto& t : triangles) {
+    const Eigen::Vector3d a = positions[t[0]].cast<double>(), b = positions[t[1]].cast<double>(),
+                          c = positions[t[2]].cast<double>();
+    area += 0.5 * (b - a).cross(c - a).norm();
+  }
+  return area;
+}
+
 Mesh parse_ply(std::string_view bytes, const std::string& source) {
   // Header: lines up to "end_header".
   std::size_t pos = 0;
@@ -269,7 +303,8 @@ Mesh parse_ply(std::string_view bytes, const std::string& source) {
             values[i] = body.read(p.type, where);
           }
         }
-        const Vec3f position(float(values[x]), float(values[y]), float(values[z]));
+        const Vec3f position(static_cast<float>(values[x]), static_cast<float>(values[y]),
+                             static_cast<float>(values[z]));
         check_finite(position, source, where);
         mesh.positions.push_back(position);
         if (normals) mesh.normals.emplace_back(float(values[nx]), float(values[ny]), float(values[nz]));

@@ -10,6 +10,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -295,9 +296,7 @@ std::vector<Vec3f> area_weighted_normals(const Mesh& mesh) {
 
 
 Mesh load_mesh(const std::string& name_or_path, double object_size_mm) {
-  if (!(object_size_mm > 0) || !std::isfinite(object_size_mm)) {
-    throw Error("--object-size-mm: must be positive, got " + std::to_string(object_size_mm));
-  }
+  check_object_size(object_size_mm);
   Mesh mesh;
   bool exact_normals = false;
   if (name_or_path == "sphere") {
@@ -324,6 +323,21 @@ Mesh load_mesh(const std::string& name_or_path, double object_size_mm) {
     }
     mesh = load_mesh_file(path);
   }
+  return finish_mesh(std::move(mesh), name_or_path, object_size_mm, exact_normals);
+}
+
+void check_object_size(double object_size_mm) {
+  if (!(object_size_mm > 0 && object_size_mm <= kMaxObjectSizeMm)) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%g", object_size_mm);
+    throw Error(std::string("--object-size-mm: expected a bounding-box diagonal in (0, 1e6] mm, got ") +
+                text);
+  }
+}
+
+Mesh finish_mesh(Mesh mesh, const std::string& name_or_path, double object_size_mm,
+                 bool exact_normals) {
+  check_object_size(object_size_mm);
   mesh.name = name_or_path;
 
   drop_degenerate_triangles(mesh);

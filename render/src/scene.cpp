@@ -1,4 +1,4 @@
-// Mesh measures, lights from the command line, the orbit camera
+// Lights from the command line, the orbit camera
 // (render/include/lucent/render/scene.h).
 #include <algorithm>
 #include <cmath>
@@ -15,39 +15,6 @@
 #include "lucent/render/scene.h"
 
 namespace lucent::render {
-
-Vec3f Mesh::bounds_min() const {
-  Vec3f lo = Vec3f::Constant(std::numeric_limits<float>::infinity());
-  for (const Vec3f& p : positions) lo = lo.cwiseMin(p);
-  return positions.empty() ? Vec3f::Zero() : lo;
-}
-
-Vec3f Mesh::bounds_max() const {
-  Vec3f hi = Vec3f::Constant(-std::numeric_limits<float>::infinity());
-  for (const Vec3f& p : positions) hi = hi.cwiseMax(p);
-  return positions.empty() ? Vec3f::Zero() : hi;
-}
-
-Vec3f Mesh::centre() const {
-  return 0.5f * (bounds_min() + bounds_max());
-}
-
-float Mesh::bounding_radius() const {
-  const Vec3f c = centre();
-  float r2 = 0;
-  for (const Vec3f& p : positions) r2 = std::max(r2, (p - c).squaredNorm());
-  return std::sqrt(r2);
-}
-
-double Mesh::surface_area() const {
-  double area = 0;
-  for (const auto& t : triangles) {
-    const Eigen::Vector3d a = positions[t[0]].cast<double>(), b = positions[t[1]].cast<double>(),
-                          c = positions[t[2]].cast<double>();
-    area += 0.5 * (b - a).cross(c - a).norm();
-  }
-  return area;
-}
 
 namespace {
 

@@ -58,6 +58,10 @@ std::string to_string(Response response);
 /// checked when the images are read). Throws lucent::Error "<file>: field '<name>': <expected>".
 Capture read_capture(const std::filesystem::path& path);
 
+/// read_capture on a document already parsed; image paths are relative to `base_dir`.
+Capture capture_from_json(const nlohmann::json& doc, const std::string& source,
+                          const std::filesystem::path& base_dir);
+
 /// The document for `capture` with paths as given (write them relative to the file's folder).
 nlohmann::json capture_to_json(const Capture& capture);
 

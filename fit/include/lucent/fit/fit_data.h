@@ -6,7 +6,10 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 namespace lucent::fit {
 
@@ -65,5 +68,10 @@ struct ProfileData {
 /// photon arrived) are skipped and counted. Throws lucent::Error with one line naming the file,
 /// line or field.
 ProfileData load_profile_data(const std::filesystem::path& path);
+
+/// The two readers load_profile_data chooses between, on bytes already read (the fuzz targets use
+/// them); `source` names the file in errors.
+ProfileData parse_profile_csv(std::string_view text, const std::string& source);
+ProfileData profile_data_from_json(const nlohmann::json& doc, const std::string& source);
 
 }  // namespace lucent::fit

@@ -23,4 +23,17 @@ Mesh parse_ply(std::string_view bytes, const std::string& source);
 /// renderer computes area-weighted ones. Other statements are ignored.
 Mesh parse_obj(std::string_view text, const std::string& source);
 
+/// Largest bounding-box diagonal a scene may have, mm (1 km; beyond it float positions lose the
+/// sub-millimetre precision scattering needs).
+inline constexpr double kMaxObjectSizeMm = 1e6;
+
+/// Throws lucent::Error naming --object-size-mm unless 0 < size <= kMaxObjectSizeMm.
+void check_object_size(double object_size_mm);
+
+/// What load_mesh does after reading: drops degenerate triangles, refuses a mesh without any,
+/// centres and scales it to `object_size_mm`, orients it outward and gives it unit normals (the
+/// file's where usable, else area-weighted), warning about non-manifold edges.
+Mesh finish_mesh(Mesh mesh, const std::string& name_or_path, double object_size_mm,
+                 bool exact_normals = false);
+
 }  // namespace lucent::render
