@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "commands.h"
+#include "validators.h"
 #include "lucent/acquire/acquire.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
@@ -41,17 +42,17 @@ void register_acquire_command(CLI::App& app) {
   cmd->add_option("--bins", args->options.bins,
                   "number of radial bins from 0 to the radius (default 150); bins with too few "
                   "pixels are dropped")
-      ->check(CLI::Range(1, 1000000));
+      ->check(whole_in(1, 1000000, "radial bins"));
   cmd->add_flag("--log-bins", args->options.log_bins,
                 "log-spaced bins from half a pixel pitch to the radius (first bin [0, pitch/2))");
   auto* radius = cmd->add_option("--radius-mm", args->radius_mm,
                                  "outer radius of the bins and 2D samples, mm (default: distance "
                                  "from the entry point to the nearest image edge)")
-                     ->check(CLI::PositiveNumber);
+                     ->check(number_in(0, 1e6, "mm", true));
   cmd->add_option(
          "--min-pixels", args->options.min_pixels_per_bin,
          "drop radial bins with fewer unmasked pixels than this in any channel (default 3)")
-      ->check(CLI::Range(2, 1000000000));
+      ->check(whole_in(2, 1000000000, "pixels per bin"));
   cmd->add_flag("--json", args->json, "print the summary as JSON on standard output");
   cmd->callback([args, radius] {
     set_replace_folders(args->force);

@@ -1,9 +1,11 @@
 // `lucent fit`: profiles in, a material file out.
+#include <charconv>
 #include <cmath>
 #include <iostream>
 #include <memory>
 
 #include "commands.h"
+#include "validators.h"
 #include "lucent/materials/json_file.h"
 #include "lucent/materials/transport_table.h"
 #include "lucent/fit/fit.h"
@@ -22,6 +24,8 @@ struct FitArguments {
   std::string quality = "balanced";
   std::string plot, report, name;
   double exclude_radius_mm = -1;
+  CLI::Option* exclude_option = nullptr;
+  CLI::Option* ior_option = nullptr;
   double ior = 0;
   double g = 0;
   std::string table;
@@ -62,16 +66,19 @@ fit::FitOptions to_options(const FitArguments& a) {
     else
       throw Error("--loss: expected none, huber:S or cauchy:S, got '" + a.loss + "'");
     if (colon != std::string::npos) {
-      try {
-        o.loss_scale = std::stod(a.loss.substr(colon + 1));
-      } catch (const std::exception&) {
-        throw Error("--loss: the scale S in " + a.loss + " must be a number (in standard errors)");
+      const std::string scale = a.loss.substr(colon + 1);
+      const auto [end, ec] =
+          std::from_chars(scale.data(), scale.data() + scale.size(), o.loss_scale);
+      if (ec != std::errc() || end != scale.data() + scale.size() ||
+          !(o.loss_scale > 0 && o.loss_scale <= 1e6)) {
+        throw Error("--loss: the scale S in '" + a.loss +
+                    "' must be a number in (0, 1e6] standard errors");
       }
-      if (!(o.loss_scale > 0)) throw Error("--loss: the scale S must be > 0 standard errors");
     }
   }
-  if (a.exclude_radius_mm >= 0) o.exclude_radius_mm = a.exclude_radius_mm;
-  if (a.ior != 0) {
+  // Given or not is what counts (the validators have checked the values): no value falls back.
+  if (a.exclude_option && a.exclude_option->count() > 0) o.exclude_radius_mm = a.exclude_radius_mm;
+  if (a.ior_option && a.ior_option->count() > 0) {
     if (!(a.ior > 0 && a.ior <= 4)) throw Error("--ior: expected a relative index in (0, 4]");
     o.ior = a.ior;
   }
@@ -166,16 +173,19 @@ void register_fit_command(CLI::App& app) {
   cmd->add_option("--g", args->g,
                   "Henyey-Greenstein g the tabulated model assumes (radial data cannot tell g "
                   "from sigma_s; the report says how far the answer moves)")
+      ->check(number_in(0, 0.95, "(Henyey-Greenstein g)"))
       ->capture_default_str();
   cmd->add_option("--table", args->table,
                   "transport table for the tabulated model (default: the shipped one)");
-  cmd->add_option(
+  args->exclude_option = cmd->add_option(
       "--exclude-radius-mm", args->exclude_radius_mm,
       "leave out samples closer to the entry point than this, mm, in every channel (default: "
       "per channel; tabulated: two pixels or 0.1 mean free path, dipoles: one transport mean "
-      "free path)");
-  cmd->add_option("--ior", args->ior,
-                  "relative index of refraction of the sample (required with CSV)");
+      "free path)")
+      ->check(number_in(0, 1e6, "mm"));
+  args->ior_option = cmd->add_option("--ior", args->ior,
+                  "relative index of refraction of the sample (required with CSV)")
+      ->check(number_in(0, 4, "(relative index of refraction)", true));
   cmd->add_flag("--fit-ior", args->fit_ior, "fit the index too (one for all channels)");
   cmd->add_flag("--relative", args->relative,
                 "fit a global scale (automatic when the profile says it is relative)");

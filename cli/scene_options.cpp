@@ -1,6 +1,8 @@
 // The options `lucent render` and `lucent view` share (see scene_options.h).
 #include "scene_options.h"
 
+#include "validators.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -94,6 +96,7 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
       ->capture_default_str();
   cmd->add_option("--size", args->size, size_help)->capture_default_str();
   cmd->add_option("--object-size-mm", args->object_size_mm, "bounding-box diagonal of the mesh, mm")
+      ->check(number_in(0, 1e6, "mm", true))
       ->capture_default_str();
   cmd->add_option("--exposure", args->exposure,
                   "linear scale before the tone curve (PNG only; EXR stays linear), or auto: the "
@@ -103,6 +106,7 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
                   "GGX width alpha of the surface's specular lobe for every light (0 = smooth: "
                   "no highlight from point or directional lights, only the environment's "
                   "mirror image)")
+      ->check(number_in(0, 1, "(GGX alpha)"))
       ->capture_default_str();
   cmd->add_option("--specular", args->specular,
                   "on or off: the lights' specular lobe (off: the subsurface term alone, for "
@@ -118,17 +122,22 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
       ->capture_default_str();
   cmd->add_option("--samples-pixel", args->reference.pixel_samples,
                   "reference (probes): probes per pixel per pass")
+      ->check(whole_in(1, 10000000, "probes per pixel"))
       ->capture_default_str();
   cmd->add_option("--samples-reference", args->reference.surface_samples,
                   "reference (area): surface samples per pass (uniform by area)")
+      ->check(whole_in(1, 1000000000, "surface samples"))
       ->capture_default_str();
   cmd->add_option("--passes", args->reference.passes,
                   "reference: progressive passes, each with new samples (image = their mean)")
+      ->check(whole_in(1, 1000000, "passes"))
       ->capture_default_str();
   cmd->add_option("--threads", args->reference.threads, "reference: worker threads (0 = all)")
+      ->check(thread_count())
       ->capture_default_str();
   cmd->add_option("--seed", args->reference.seed,
                   "random seed (reference samples, environment-light placement)")
+      ->check(seed_value())
       ->capture_default_str();
   cmd->add_option("--frames", args->settings.frames, "maps: T, frames accumulated")
       ->capture_default_str();
@@ -176,7 +185,11 @@ SceneSetup build_scene(SceneArguments& args) {
   }
   const auto view =
       parse_numbers(args.view, "--view", 3, ',', "AZ,EL,DIST (degrees, degrees, bounding radii)");
-  if (!(view[2] > 0)) throw Error("--view: DIST must be positive, got '" + args.view + "'");
+  if (!(view[2] > 0 && view[2] <= 1e4) || !(std::abs(view[0]) <= 3600) ||
+      !(std::abs(view[1]) <= 90)) {
+    throw Error("--view: expected AZ in [-3600, 3600] degrees, EL in [-90, 90] degrees and DIST "
+                "in (0, 1e4] bounding radii, got '" + args.view + "'");
+  }
   if (args.technique != "maps" && args.technique != "reference") {
     throw Error("--technique: expected maps or reference, got '" + args.technique + "'");
   }
@@ -203,7 +216,8 @@ SceneSetup build_scene(SceneArguments& args) {
     args.settings.exposure = 1.0f;
   } else {
     const auto e = parse_numbers(args.exposure, "--exposure", 1, ',', "a positive number or auto");
-    if (!(e[0] > 0)) throw Error("--exposure: must be positive or auto, got '" + args.exposure + "'");
+    if (!(e[0] > 0 && e[0] <= 1e12))
+      throw Error("--exposure: expected a scale in (0, 1e12] or auto, got '" + args.exposure + "'");
     args.auto_exposure = false;
     args.settings.exposure = float(e[0]);
   }
@@ -216,8 +230,8 @@ SceneSetup build_scene(SceneArguments& args) {
   Vec3f backdrop = Vec3f::Zero();
   if (!args.backdrop.empty()) {
     const auto b = parse_numbers(args.backdrop, "--backdrop", 3, ',', "R,G,B radiance >= 0");
-    if (b[0] < 0 || b[1] < 0 || b[2] < 0) {
-      throw Error("--backdrop: expected R,G,B radiance >= 0, got '" + args.backdrop + "'");
+    if (b[0] < 0 || b[1] < 0 || b[2] < 0 || b[0] > 1e12 || b[1] > 1e12 || b[2] > 1e12) {
+      throw Error("--backdrop: expected R,G,B radiance in [0, 1e12], got '" + args.backdrop + "'");
     }
     backdrop = Vec3f(float(b[0]), float(b[1]), float(b[2]));
   }

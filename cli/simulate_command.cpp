@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "commands.h"
+#include "validators.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/acquire/simulate.h"
 #include "lucent/materials/error.h"
@@ -147,10 +148,13 @@ void register_simulate_command(CLI::App& app) {
                   "model (for round trips of lucent fit)")
       ->capture_default_str();
   cmd->add_option("--photons", o.transport.photons, "photons per colour channel")
+      ->check(whole_in(100, 1000000000000000ull, "photons per channel"))
       ->capture_default_str();
   cmd->add_option("--seed", o.transport.seed, "random seed (results identical for any --threads)")
+      ->check(seed_value())
       ->capture_default_str();
   cmd->add_option("--threads", o.transport.threads, "worker threads (0 = all cores)")
+      ->check(thread_count())
       ->capture_default_str();
   cmd->add_option("--thickness-mm", o.transport.thickness_mm,
                   "slab thickness in mm (default: semi-infinite)");
@@ -159,34 +163,44 @@ void register_simulate_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--azimuth-deg", o.transport.azimuth_deg,
                   "beam direction of travel in the image plane, degrees from +x")
+      ->check(number_in(-360, 360, "degrees"))
       ->capture_default_str();
   cmd->add_option("--view-deg", o.transport.view_deg,
                   "camera angle from the normal, degrees [0, 90)")
       ->capture_default_str();
   cmd->add_option("--view-azimuth-deg", o.transport.view_azimuth_deg,
                   "camera azimuth, degrees from +x")
+      ->check(number_in(-360, 360, "degrees"))
       ->capture_default_str();
   cmd->add_option("--size", o.transport.size, "image width and height, pixels")
+      ->check(whole_in(1, 16384, "an image size in pixels"))
       ->capture_default_str();
   cmd->add_option("--pixel-mm", o.transport.pixel_mm, "pixel pitch on the sample, mm")
+      ->check(number_in(0, 100, "mm", true))
       ->capture_default_str();
   cmd->add_option("--max-radius-mm", o.transport.max_radius_mm,
                   "outer radius of the radial exitance table, mm")
+      ->check(number_in(0, 1e6, "mm", true))
       ->capture_default_str();
   cmd->add_option("--exposures", args->exposures, "exposure times in s, increasing")
       ->capture_default_str();
   cmd->add_option("--response", args->response, "camera encoding: srgb or linear")
       ->capture_default_str();
-  cmd->add_option("--bits", o.camera.bits, "bits per channel: 8 or 16")->capture_default_str();
+  cmd->add_option("--bits", o.camera.bits, "bits per channel: 8 or 16")
+      ->check(whole_in(8, 16, "bits per channel (8 or 16)"))->capture_default_str();
   cmd->add_option("--full-well-e", o.camera.full_well_e, "electrons at saturation")
+      ->check(number_in(100, 1e9, "electrons"))
       ->capture_default_str();
   cmd->add_option("--read-noise-e", o.camera.read_noise_e, "read noise, electrons rms")
+      ->check(number_in(0, 1e8, "electrons rms"))
       ->capture_default_str();
   cmd->add_option("--black-level-e", o.camera.black_level_e, "pedestal, electrons")
+      ->check(number_in(0, 5e8, "electrons"))
       ->capture_default_str();
   cmd->add_option("--camera-scale", o.camera.electrons_per_radiance_s,
                   "electrons per (radiance x s); 0 = brightest pixel half-fills the well at the "
                   "shortest exposure")
+      ->check(number_in(0, 1e30, "electrons per (radiance s); 0: automatic"))
       ->capture_default_str();
   cmd->add_flag("--no-noise", args->no_noise, "noise-free camera (exact expected values)");
   cmd->add_flag("--no-white-reference", args->no_white, "do not image the white reference");

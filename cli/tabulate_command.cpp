@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "commands.h"
+#include "validators.h"
 #include "lucent/acquire/tabulate.h"
 #include "lucent/materials/error.h"
 #include "lucent/materials/profile_table.h"
@@ -120,8 +121,10 @@ void register_tabulate_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--photons", o.photons, "photons per (eta, g) slice")->capture_default_str();
   cmd->add_option("--seed", o.seed, "random seed (same table for any --threads or sharding)")
+      ->check(seed_value())
       ->capture_default_str();
-  cmd->add_option("--threads", o.threads, "worker threads (0 = all cores)")->capture_default_str();
+  cmd->add_option("--threads", o.threads, "worker threads (0 = all cores)")
+      ->check(thread_count())->capture_default_str();
   cmd->add_option("--groups", o.groups, "independent photon groups per slice (standard errors)")
       ->capture_default_str();
   cmd->add_option("--max-path", o.max_path, "paths cut at this length, units of 1/sigma_s'")

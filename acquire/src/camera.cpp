@@ -1,5 +1,6 @@
 #include "lucent/acquire/camera.h"
 
+#include <cstdio>
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -28,6 +29,53 @@ double srgb_decode(double v) {
   return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
 }
 
+namespace {
+
+std::string number(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%g", v);
+  return buffer;
+}
+
+}  // namespace
+
+void validate_camera_options(const CameraOptions& o) {
+  if (o.exposures_s.empty()) throw Error("--exposures: expected at least one exposure time");
+  for (std::size_t k = 0; k < o.exposures_s.size(); ++k) {
+    const double t = o.exposures_s[k];
+    if (!(t > 0 && t <= 1e6)) {
+      throw Error("--exposures: each exposure must be a time in (0, 1e6] s, got " + number(t));
+    }
+    if (k > 0 && !(t > o.exposures_s[k - 1])) {
+      throw Error("--exposures: exposure times must increase strictly");
+    }
+  }
+  if (o.bits != 8 && o.bits != 16) throw Error("--bits: expected 8 or 16");
+  if (o.response == Response::kCalibrate) {
+    throw Error("--response: a simulated camera is 'linear' or 'srgb'");
+  }
+  if (!(o.full_well_e >= 100 && o.full_well_e <= 1e9)) {
+    throw Error("--full-well-e: expected the electrons at saturation in [100, 1e9], got " +
+                number(o.full_well_e));
+  }
+  if (!(o.read_noise_e >= 0 && o.read_noise_e <= 0.1 * o.full_well_e)) {
+    throw Error("--read-noise-e: expected read noise in [0, full well / 10] electrons rms, got " +
+                number(o.read_noise_e));
+  }
+  if (!(o.black_level_e >= 0 && o.black_level_e <= 0.5 * o.full_well_e)) {
+    throw Error("--black-level-e: expected a pedestal in [0, full well / 2] electrons, got " +
+                number(o.black_level_e));
+  }
+  if (!(o.electrons_per_radiance_s == 0 ||
+        (o.electrons_per_radiance_s > 0 && o.electrons_per_radiance_s <= 1e30))) {
+    throw Error("--camera-scale: expected electrons per (radiance s) in (0, 1e30], or 0 for "
+                "automatic, got " + number(o.electrons_per_radiance_s));
+  }
+  if (!(o.auto_fill > 0 && o.auto_fill <= 1)) {
+    throw Error("camera: auto_fill must be in (0, 1], got " + number(o.auto_fill));
+  }
+}
+
 double camera_scale(const CameraOptions& options, double peak_radiance) {
   if (options.electrons_per_radiance_s > 0) return options.electrons_per_radiance_s;
   if (!(peak_radiance > 0))
@@ -39,10 +87,7 @@ double camera_scale(const CameraOptions& options, double peak_radiance) {
 
 RawImage expose(const ImageRgb& radiance, double exposure_s, double scale,
                 const CameraOptions& options, std::uint64_t stream) {
-  if (options.bits != 8 && options.bits != 16) throw Error("--bits: expected 8 or 16");
-  if (options.response == Response::kCalibrate) {
-    throw Error("--response: a simulated camera is 'linear' or 'srgb'");
-  }
+  validate_camera_options(options);
   const int max_value = options.bits == 8 ? 255 : 65535;
   RawImage out(radiance.width, radiance.height, max_value);
   std::mt19937_64 rng(splitmix64(options.seed ^ splitmix64(stream)));

@@ -8,24 +8,116 @@
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cmath>
+#include <mutex>
+#include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
+#include "lucent/materials/json_file.h"
 
 namespace lucent::acquire {
+
+namespace {
+
+// Largest image lucent reads: 2^28 pixels (16384 x 16384), so that a header cannot make it
+// allocate more than a few GiB.
+constexpr long long kMaxPixels = 1ll << 28;
+
+// libpng and libtiff print warnings on stderr themselves ("libpng warning: iCCP: ..."), and
+// OpenCV logs its own; lucent's one error line must be all a user sees. OpenCV's log is silenced;
+// the decoders' own prints are kept off stderr by pointing file descriptor 2 at /dev/null for the
+// duration of the call (one call at a time).
+class QuietStderr {
+ public:
+  QuietStderr() : lock_(mutex()) {
+    std::fflush(stderr);
+    saved_ = ::dup(2);
+    const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+    if (saved_ >= 0 && null >= 0) ::dup2(null, 2);
+    if (null >= 0) ::close(null);
+  }
+  ~QuietStderr() {
+    std::fflush(stderr);
+    if (saved_ >= 0) {
+      ::dup2(saved_, 2);
+      ::close(saved_);
+    }
+  }
+  QuietStderr(const QuietStderr&) = delete;
+  QuietStderr& operator=(const QuietStderr&) = delete;
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  std::lock_guard<std::mutex> lock_;
+  int saved_ = -1;
+};
+
+cv::Mat decode_image_quietly(const std::filesystem::path& path, int flags) {
+  static const bool silenced = [] {
+    cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+    return true;
+  }();
+  (void)silenced;
+  // Read by lucent (bounded, recorded as an input), decoded from memory by OpenCV.
+  const std::string bytes = read_input_file(path, std::size_t(1) << 30);
+  const cv::Mat buffer(1, static_cast<int>(bytes.size()), CV_8U,
+                       const_cast<char*>(bytes.data()));
+  cv::Mat mat;
+  try {
+    QuietStderr quiet;
+    mat = cv::imdecode(buffer, flags);
+  } catch (const cv::Exception&) {
+    mat.release();
+  }
+  if (!mat.empty() && static_cast<long long>(mat.cols) * mat.rows > kMaxPixels) {
+    throw Error(path.string() + ": the image is larger than 16384 x 16384 pixels");
+  }
+  return mat;
+}
+
+}  // namespace
+
+ImageRgb read_radiance_hdr(const std::filesystem::path& path) {
+  if (!std::filesystem::exists(path)) throw Error(path.string() + ": no such image file");
+  const cv::Mat bgr = decode_image_quietly(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR);
+  if (bgr.empty()) throw Error(path.string() + ": not a readable Radiance .hdr image");
+  if (bgr.depth() != CV_32F || bgr.channels() != 3) {
+    throw Error(path.string() + ": not a floating-point (HDR) image");
+  }
+  ImageRgb image(bgr.cols, bgr.rows);
+  for (int y = 0; y < bgr.rows; ++y) {
+    const cv::Vec3f* row = bgr.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < bgr.cols; ++x) {
+      for (int c = 0; c < 3; ++c) image.at(x, y, c) = row[x][2 - c];  // BGR -> RGB
+    }
+  }
+  return image;
+}
 
 ImageRgb read_exr(const std::filesystem::path& path) {
   if (!std::filesystem::exists(path))
     throw Error(path.string() + ": no such file (expected an OpenEXR image)");
+  if (!std::filesystem::is_regular_file(path))
+    throw Error(path.string() + ": not a regular file (expected an OpenEXR image)");
+  note_input(path);
   try {
     Imf::InputFile file(path.c_str());
     const Imath::Box2i window = file.header().dataWindow();
-    const int width = window.max.x - window.min.x + 1;
-    const int height = window.max.y - window.min.y + 1;
+    const long long width = static_cast<long long>(window.max.x) - window.min.x + 1;
+    const long long height = static_cast<long long>(window.max.y) - window.min.y + 1;
     if (width <= 0 || height <= 0) throw Error(path.string() + ": empty OpenEXR image");
+    if (width * height > kMaxPixels)
+      throw Error(path.string() + ": the OpenEXR image is larger than 16384 x 16384 pixels");
     const Imf::ChannelList& channels = file.header().channels();
     const bool rgb =
         channels.findChannel("R") && channels.findChannel("G") && channels.findChannel("B");
@@ -58,6 +150,15 @@ void write_exr(const std::filesystem::path& path, const ImageRgb& image,
                const std::map<std::string, std::string>& attributes) {
   if (image.width <= 0 || image.height <= 0)
     throw Error(path.string() + ": refusing to write an empty image");
+  for (std::size_t i = 0; i < image.data.size(); ++i) {
+    if (!std::isfinite(image.data[i])) {
+      const std::size_t pixel = i / 3;
+      throw Error(path.string() + ": cannot write: pixel (" +
+                  std::to_string(pixel % std::size_t(image.width)) + ", " +
+                  std::to_string(pixel / std::size_t(image.width)) +
+                  ") is not finite (lucent writes only finite values)");
+    }
+  }
   AtomicOutputPath out(path);
   try {
     Imf::Header header(image.width, image.height);
@@ -83,7 +184,7 @@ void write_exr(const std::filesystem::path& path, const ImageRgb& image,
 
 RawImage read_raw_image(const std::filesystem::path& path) {
   if (!std::filesystem::exists(path)) throw Error(path.string() + ": no such image file");
-  const cv::Mat mat = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+  const cv::Mat mat = decode_image_quietly(path, cv::IMREAD_UNCHANGED);
   if (mat.empty()) throw Error(path.string() + ": cannot read as an image (expected PNG or TIFF)");
   int max_value = 0;
   if (mat.depth() == CV_8U)

@@ -463,7 +463,7 @@ Estimate estimate(const Moments& m, std::uint64_t photons, double scale = 1.0) {
 
 [[noreturn]] void bad_option(const std::string& name, const std::string& expected, double got) {
   std::ostringstream s;
-  s.precision(17);
+  s.precision(6);
   s << "photon transport: option '" << name << "' must be " << expected << " (got " << got << ")";
   throw Error(s.str());
 }
@@ -509,9 +509,11 @@ std::vector<ExitanceBin> exitance_bins(double max_radius_mm) {
 }
 
 void validate_photon_transport_options(const PhotonTransportOptions& o) {
-  if (o.photons < 1 || o.photons > kMaxPhotons) {
-    bad_option("photons", "in [1, 1e15]", static_cast<double>(o.photons));
+  // Fewer than 100 photons give no usable standard error (every tally bin holds 0 or 1 photon).
+  if (o.photons < 100 || o.photons > kMaxPhotons) {
+    bad_option("photons", "in [100, 1e15] per channel", static_cast<double>(o.photons));
   }
+  if (o.threads > 1024) bad_option("threads", "at most 1024 (0: all cores)", o.threads);
   if (!(o.thickness_mm > 0))
     bad_option("thickness_mm", "> 0 (infinity: semi-infinite)", o.thickness_mm);
   if (!(o.incidence_deg >= 0 && o.incidence_deg < 90)) {

@@ -151,18 +151,11 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
   PhotonTransportOptions transport = options.transport;
   for (int c = 0; c < 3; ++c) transport.media[c] = options.material.medium(c);
   transport.image = !options.profile_only;
-  if (!options.profile_only) {
-    if (options.camera.exposures_s.empty()) throw Error("--exposures: expected at least one time");
-    for (std::size_t k = 0; k < options.camera.exposures_s.size(); ++k) {
-      const double t = options.camera.exposures_s[k];
-      if (!(t > 0)) throw Error("--exposures: each exposure must be > 0 s");
-      if (k > 0 && !(t > options.camera.exposures_s[k - 1])) {
-        throw Error("--exposures: exposure times must increase strictly");
-      }
-    }
-    if (options.camera.bits != 8 && options.camera.bits != 16)
-      throw Error("--bits: expected 8 or 16");
-  }
+  // One seed drives every random choice: the camera's noise comes from the transport's seed (a
+  // stream of its own), so repeated captures with different --seed differ in their noise too.
+  CameraOptions camera = camera;
+  camera.seed = transport.seed ^ 0x9E3779B97F4A7C15ull;
+  if (!options.profile_only) validate_camera_options(camera);
   validate_photon_transport_options(transport);
   AtomicOutputDir out(out_dir);  // checks the folder can be made before the long simulation
 
@@ -198,7 +191,7 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
                                   ? to_image(result, false)
                                   : model_radiance(options.material, options.source, transport);
     const double pixel_area = transport.pixel_mm * transport.pixel_mm;
-    const double scale = camera_scale(options.camera, peak(radiance));
+    const double scale = camera_scale(camera, peak(radiance));
     summary.camera_scale = scale;
     write_exr(out.temporary() / "truth_radiance.exr", radiance,
               {{"units", "radiance per unit incident power, mm^-2 sr^-1"}});
@@ -221,12 +214,12 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
     if (transport.incidence_deg > 0) {
       capture.beam_point_px = std::array<double, 2>{transport.size / 2.0, transport.size / 2.0};
     }
-    capture.response = options.camera.response;
+    capture.response = camera.response;
     std::uint64_t stream = 0;
-    for (std::size_t k = 0; k < options.camera.exposures_s.size(); ++k) {
-      const double t = options.camera.exposures_s[k];
+    for (std::size_t k = 0; k < camera.exposures_s.size(); ++k) {
+      const double t = camera.exposures_s[k];
       const std::string name = bracket_name("bracket", k);
-      write_png(out.temporary() / name, expose(radiance, t, scale, options.camera, stream++));
+      write_png(out.temporary() / name, expose(radiance, t, scale, camera, stream++));
       capture.sample.images.push_back({name, t});
       summary.files.push_back(name);
     }
@@ -242,10 +235,10 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
       const double shorten = std::max(1.0, std::exp2(std::ceil(std::log2(ratio))));
       WhiteReference reference;
       reference.reflectance = options.white_reflectance;
-      for (std::size_t k = 0; k < options.camera.exposures_s.size(); ++k) {
-        const double t = options.camera.exposures_s[k] / shorten;
+      for (std::size_t k = 0; k < camera.exposures_s.size(); ++k) {
+        const double t = camera.exposures_s[k] / shorten;
         const std::string name = bracket_name("white", k);
-        write_png(out.temporary() / name, expose(white, t, scale, options.camera, stream++));
+        write_png(out.temporary() / name, expose(white, t, scale, camera, stream++));
         reference.images.images.push_back({name, t});
         summary.files.push_back(name);
       }
@@ -257,7 +250,7 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
     if (options.dark_frame) {
       const ImageRgb black(transport.size, transport.size, 0.0f);
       write_png(out.temporary() / "dark.png",
-                expose(black, options.camera.exposures_s.back(), scale, options.camera, stream++));
+                expose(black, camera.exposures_s.back(), scale, camera, stream++));
       capture.dark = "dark.png";
       summary.files.push_back("dark.png");
     }
@@ -266,7 +259,7 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
                           {"truth", "truth.json"}};
     write_capture(out.temporary() / "capture.json", capture);
     summary.files.push_back("capture.json");
-    truth["camera"] = camera_to_json(options.camera, scale);
+    truth["camera"] = camera_to_json(camera, scale);
     truth["white_reference"] = white_json;
     truth["pixel_area_mm2"] = pixel_area;
   }

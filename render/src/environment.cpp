@@ -5,7 +5,6 @@
 #include <cctype>
 #include <cmath>
 #include <numbers>
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "lucent/acquire/image_io.h"
@@ -23,26 +22,6 @@ std::string lower_extension(const fs::path& path) {
   return e;
 }
 
-acquire::ImageRgb read_radiance_hdr(const fs::path& path) {
-  cv::Mat bgr;
-  try {
-    bgr = cv::imread(path.string(), cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR);
-  } catch (const cv::Exception&) {
-    bgr.release();
-  }
-  if (bgr.empty()) throw Error(path.string() + ": not a readable Radiance .hdr image");
-  if (bgr.depth() != CV_32F || bgr.channels() != 3) {
-    throw Error(path.string() + ": not a floating-point (HDR) image");
-  }
-  acquire::ImageRgb image(bgr.cols, bgr.rows);
-  for (int y = 0; y < bgr.rows; ++y) {
-    const cv::Vec3f* row = bgr.ptr<cv::Vec3f>(y);
-    for (int x = 0; x < bgr.cols; ++x) {
-      for (int c = 0; c < 3; ++c) image.at(x, y, c) = row[x][2 - c];  // BGR -> RGB
-    }
-  }
-  return image;
-}
 
 float luminance(float r, float g, float b) {
   return 0.2126f * r + 0.7152f * g + 0.0722f * b;
@@ -98,7 +77,7 @@ EnvironmentMap load_environment(const fs::path& path) {
   if (ext == ".exr") {
     map.image = acquire::read_exr(path);
   } else if (ext == ".hdr") {
-    map.image = read_radiance_hdr(path);
+    map.image = acquire::read_radiance_hdr(path);
   } else {
     throw Error(path.string() +
                 ": environment maps must be OpenEXR (.exr) or Radiance (.hdr) "
@@ -107,6 +86,11 @@ EnvironmentMap load_environment(const fs::path& path) {
   for (float& v : map.image.data) {
     if (!std::isfinite(v)) {
       throw Error(path.string() + ": environment map has non-finite (NaN or infinite) pixels");
+    }
+    // As for --light: the renderer sums radiance in float; 1e38 overflows at the first product.
+    if (v > 1e12f) {
+      throw Error(path.string() + ": environment map has a pixel brighter than 1e12 (scale the "
+                  "map down; images are relative)");
     }
     v = std::max(v, 0.0f);  // negative radiance (from filtering or compression) is clamped to 0
   }

@@ -65,12 +65,21 @@ Light parse_light(const std::string& text) {
     if (!(v.norm() > 0)) throw bad("the direction must not be zero");
     light.direction = v.normalized();
   } else {
+    // A light farther than 1 km from a scene of at most 1 km (kMaxObjectSizeMm) is a directional
+    // one; positions beyond it overflow the ray queries' float ranges.
+    if (!(v.cwiseAbs().maxCoeff() <= 1e6f)) {
+      throw bad("the position must be within 1e6 mm of the mesh centre (use a directional light "
+                "for a light that far)");
+    }
     light.position = v;
   }
   if (!parse_triple(colour, light.radiance)) {
     throw bad("the colour must be three comma-separated numbers R,G,B; " + expected);
   }
   if ((light.radiance.array() < 0).any()) throw bad("the colour must not be negative");
+  // Radiometry in float: 1e38 overflows to infinity at the first product. Images are relative, so
+  // nothing is lost by asking for values a float can carry through the renderer's sums.
+  if (!(light.radiance.maxCoeff() <= 1e12f)) throw bad("each of R,G,B must be at most 1e12");
   return light;
 }
 

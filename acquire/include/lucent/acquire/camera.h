@@ -25,8 +25,14 @@ struct CameraOptions {
   /// 0 picks it so that the brightest pixel at the shortest exposure fills `auto_fill` of the well.
   double electrons_per_radiance_s = 0;
   double auto_fill = 0.5;
-  std::uint64_t seed = 1;  ///< noise stream; each image gets its own stream derived from it
+  /// Noise stream; each image gets its own stream derived from it. run_simulation sets it from the
+  /// transport's seed (one --seed for everything) and records it in truth.json.
+  std::uint64_t seed = 1;
 };
+
+/// Throws lucent::Error naming the CLI option (--full-well-e, --read-noise-e, --black-level-e,
+/// --camera-scale, --exposures, --bits, --response) for a value no camera has, with its unit.
+void validate_camera_options(const CameraOptions& options);
 
 /// The electrons-per-(radiance s) factor `options` gives for an image whose brightest value is
 /// `peak_radiance` (options.electrons_per_radiance_s when that is set).

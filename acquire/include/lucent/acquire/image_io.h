@@ -25,6 +25,9 @@ RawImage read_raw_image(const std::filesystem::path& path);
 /// Writes an 8- or 16-bit RGB PNG (max_value 255 or 65535), atomically.
 void write_png(const std::filesystem::path& path, const RawImage& image);
 
+/// Linear float RGB from a Radiance RGBE (.hdr) file.
+ImageRgb read_radiance_hdr(const std::filesystem::path& path);
+
 /// Either reader by extension: .exr -> read_exr; anything else -> read_raw_image scaled to [0, 1].
 ImageRgb read_any_image(const std::filesystem::path& path);
 
