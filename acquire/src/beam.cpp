@@ -104,6 +104,10 @@ BeamPoint find_beam_point(const HdrResult& hdr, const std::string& source,
     if (kind[i] == kMeasured && luminance[i] > peak) peak = luminance[i], seed = i;
   }
   beam.peak = peak;
+  if (beam.saturated_pixels == 0 && !std::isfinite(peak)) {
+    throw Error(source + ": no beam found: no pixel holds a usable measurement (every one is "
+                "masked: non-finite, negative or outside the brackets' range)");
+  }
   if (beam.saturated_pixels > 0) {
     std::vector<std::uint8_t> labelled(pixels, 0);
     std::size_t largest = 0;

@@ -88,7 +88,8 @@ ImageSet read_image_set(const json& doc, const std::string& prefix, const FieldR
     if (!image.contains("exposure_s")) in.fail(field + ".exposure_s", "missing");
     Bracket b{in.string(image["path"], field + ".path"),
               in.number(image["exposure_s"], field + ".exposure_s")};
-    if (!(b.exposure_s > 0)) in.fail(field + ".exposure_s", "expected an exposure time > 0 s");
+    if (!(b.exposure_s >= 1e-9 && b.exposure_s <= 1e6))
+      in.fail(field + ".exposure_s", "expected an exposure time in [1e-9, 1e6] s");
     if (!set.images.empty() && !(b.exposure_s > set.images.back().exposure_s)) {
       in.fail(field + ".exposure_s",
               "exposures must increase strictly from one image to the next (got " +
@@ -157,7 +158,9 @@ Capture capture_from_json(const nlohmann::json& doc, const std::string& source,
   if (!doc.contains("pixel_pitch_mm"))
     in.fail("pixel_pitch_mm", "missing (pixel size on the sample in mm)");
   c.pixel_pitch_mm = in.number(doc["pixel_pitch_mm"], "pixel_pitch_mm");
-  if (!(c.pixel_pitch_mm > 0)) in.fail("pixel_pitch_mm", "expected a pixel pitch > 0 mm");
+  // 1 nm to 100 mm per pixel: beyond either end the profile's areas under- or overflow.
+  if (!(c.pixel_pitch_mm >= 1e-6 && c.pixel_pitch_mm <= 100))
+    in.fail("pixel_pitch_mm", "expected a pixel pitch in [1e-6, 100] mm");
 
   if (!doc.contains("incidence"))
     in.fail("incidence", "missing (expected {\"polar_deg\", \"azimuth_deg\"})");
@@ -177,13 +180,15 @@ Capture capture_from_json(const nlohmann::json& doc, const std::string& source,
   }
   if (doc.contains("ior")) {
     c.ior = in.number(doc["ior"], "ior");
-    if (!(*c.ior > 0 && *c.ior <= 4)) in.fail("ior", "expected a relative index in (0, 4]");
+    if (!(*c.ior >= 0.25 && *c.ior <= 4)) in.fail("ior", "expected a relative index in [0.25, 4]");
   }
   if (doc.contains("beam_point_px")) {
     const json& p = doc["beam_point_px"];
     if (!p.is_array() || p.size() != 2) in.fail("beam_point_px", "expected [x, y] in pixels");
     c.beam_point_px = std::array<double, 2>{in.number(p[0], "beam_point_px[0]"),
                                             in.number(p[1], "beam_point_px[1]")};
+    if (!(std::abs((*c.beam_point_px)[0]) <= 1e6 && std::abs((*c.beam_point_px)[1]) <= 1e6))
+      in.fail("beam_point_px", "expected pixel coordinates within 1e6 of the image");
   }
   if (doc.contains("response")) {
     const std::string r = in.string(doc["response"], "response");
@@ -211,7 +216,10 @@ Capture capture_from_json(const nlohmann::json& doc, const std::string& source,
   }
   if (doc.contains("beam_power")) {
     c.beam_power = in.number(doc["beam_power"], "beam_power");
-    if (!(*c.beam_power > 0)) in.fail("beam_power", "expected a power > 0");
+    // Any unit (W, or the camera's own), but a number whose inverse is a number: radiance is
+    // divided by it.
+    if (!(*c.beam_power >= 1e-30 && *c.beam_power <= 1e30))
+      in.fail("beam_power", "expected a power in [1e-30, 1e30] (in the unit the profile is per)");
   }
   if (doc.contains("provenance")) c.provenance = doc["provenance"];
   return c;

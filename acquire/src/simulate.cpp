@@ -151,10 +151,11 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
   PhotonTransportOptions transport = options.transport;
   for (int c = 0; c < 3; ++c) transport.media[c] = options.material.medium(c);
   transport.image = !options.profile_only;
-  // One seed drives every random choice: the camera's noise comes from the transport's seed (a
-  // stream of its own), so repeated captures with different --seed differ in their noise too.
-  CameraOptions camera = camera;
-  camera.seed = transport.seed ^ 0x9E3779B97F4A7C15ull;
+  // One seed drives every random choice: the camera's noise comes from the transport's seed, so
+  // repeated captures with different --seed differ in their noise too. The same value is safe: the
+  // camera's mt19937_64 streams and the transport's xoshiro streams mix it differently.
+  CameraOptions camera = options.camera;
+  camera.seed = transport.seed;
   if (!options.profile_only) validate_camera_options(camera);
   validate_photon_transport_options(transport);
   AtomicOutputDir out(out_dir);  // checks the folder can be made before the long simulation

@@ -41,7 +41,8 @@ json model_fit_json(const ModelFit& f) {
                         {"start_sigma_s_reduced", finite_or_null(c.start_sigma_s_reduced)},
                         {"samples", c.samples},
                         {"chi2", finite_or_null(c.chi2)},
-                        {"residual_rms", finite_or_null(c.residual_rms)}});
+                        {"residual_rms", finite_or_null(c.residual_rms)},
+                        {"robust_residual_rms", finite_or_null(c.robust_residual_rms)}});
   }
   return {{"model", name_of(f.model)},
           {"channels", channels},

@@ -575,10 +575,21 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
   {
     std::size_t offset = 0;
     std::array<double, 3> chi2{};
+    std::array<std::vector<double>, 3> magnitudes;  // |residual| per sample, for the median
     for (const auto& [c, count] : block_channels) {
       for (int i = 0; i < count; ++i, ++offset) {
-        if (c >= 0) chi2[c] += residuals[offset] * residuals[offset];
+        if (c < 0) continue;
+        chi2[c] += residuals[offset] * residuals[offset];
+        magnitudes[c].push_back(std::abs(residuals[offset]));
       }
+    }
+    for (int c = 0; c < 3; ++c) {
+      std::vector<double>& m = magnitudes[c];
+      if (m.empty()) continue;
+      std::nth_element(m.begin(), m.begin() + m.size() / 2, m.end());
+      // 1.4826 x the median |r|: the rms a Gaussian with that median has; a few outliers leave
+      // it alone (they are the robust loss's business), a model that misses the data does not.
+      fit.channels[c].robust_residual_rms = 1.4826 * m[m.size() / 2];
     }
     // fit.chi2 (AIC, BIC) keeps the calibration priors' share: a model that reaches the data only
     // by rescaling the calibration far beyond its uncertainty pays for it.
@@ -605,6 +616,21 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
       ch.range_diffusion_lengths =
           std::max(0.0, ch.range_end_mm - ch.exclude_radius_mm) * sigma_tr;
     }
+  }
+  // "Converged" means the data fits. Ceres' CONVERGENCE only says the steps stopped changing the
+  // cost; a channel whose residuals stay far beyond its standard errors is a solution that misses
+  // the data (a model that cannot describe it, a wrong index, a floor in the profile).
+  for (int c = 0; c < 3; ++c) {
+    const ChannelFit& ch = fit.channels[c];
+    if (!channels[c] || samples[c] == 0 || !(ch.robust_residual_rms > kMaxFittedRms)) continue;
+    std::ostringstream why;
+    why.precision(3);
+    why << "the solver stopped, but the model misses the data: channel " << "RGB"[c]
+        << "'s residuals are " << ch.robust_residual_rms
+        << " standard errors (robust rms; a fit that describes its data has about 1)";
+    fit.converged = false;
+    fit.message = why.str();
+    break;
   }
   fit.samples = samples[0] + samples[1] + samples[2];
   fit.aic = fit.chi2 + 2.0 * fit.parameters;

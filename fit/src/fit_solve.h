@@ -13,6 +13,13 @@
 
 namespace lucent::fit::detail {
 
+/// A channel whose residuals have a robust rms (1.4826 x median |r|) above this many standard
+/// errors does not fit its data, and the fit is not called converged. A good fit has about 1; up
+/// to here a model's lack of fit (the directional dipole on oblique Monte Carlo captures reaches
+/// 8.5) is carried into the reported SDs by the Birge ratio; the fits that end far off the data
+/// have 59 to 14,000.
+inline constexpr double kMaxFittedRms = 10.0;
+
 // A smooth relative change of the model, e^(epsilon shape(log10 rho)): how the tabulated model's
 // own error (its measured accuracy against fresh Monte Carlo) moves the answer.
 struct ModelPerturbation {

@@ -37,6 +37,7 @@ constexpr std::array<std::string_view, 13> kKnownFields = {
 
 // Agreement required between a given sigma_s' and sigma_s (1 - g): relative, with an absolute floor
 // for channels that (almost) do not scatter, where a relative test would demand exact zeros.
+constexpr double kMaxCoefficient = 1e6;  // mm^-1
 constexpr double kReducedRelativeTolerance = 1e-6;
 constexpr double kReducedAbsoluteTolerance = 1e-12;
 
@@ -128,26 +129,26 @@ class MaterialReader {
     Material m;
     m.name = read_name();
     m.ior = read_ior();
-    m.sigma_a = read_rgb("sigma_a", "a finite number >= 0 (mm^-1)", is_coefficient);
+    m.sigma_a = read_rgb("sigma_a", "a number in [0, 1e6] (mm^-1)", is_coefficient);
 
     const json* sigma_s = find("sigma_s");
     const json* g = find("g");
     if (sigma_s && !g) fail("g", "missing; expected together with 'sigma_s' (both or neither)");
     if (g && !sigma_s) fail("sigma_s", "missing; expected together with 'g' (both or neither)");
     if (sigma_s) {
-      m.sigma_s = read_rgb("sigma_s", "a finite number >= 0 (mm^-1)", is_coefficient);
+      m.sigma_s = read_rgb("sigma_s", "a number in [0, 1e6] (mm^-1)", is_coefficient);
       m.g = read_rgb("g", "a number in (-1, 1)", is_mean_cosine);
     }
 
     if (find("sigma_s_reduced")) {
       m.sigma_s_reduced =
-          read_rgb("sigma_s_reduced", "a finite number >= 0 (mm^-1)", is_coefficient);
+          read_rgb("sigma_s_reduced", "a number in [0, 1e6] (mm^-1)", is_coefficient);
       if (m.sigma_s) check_reduced_agrees(m);
     } else if (m.sigma_s) {
       for (int c = 0; c < 3; ++c) m.sigma_s_reduced[c] = (*m.sigma_s)[c] * (1.0 - (*m.g)[c]);
     } else {
       fail("sigma_s_reduced",
-           "missing; expected an array of 3 numbers >= 0 (mm^-1), or 'sigma_s' with 'g'");
+           "missing; expected an array of 3 numbers in [0, 1e6] (mm^-1), or 'sigma_s' with 'g'");
     }
 
     if (const json* model = find("model")) {
@@ -171,7 +172,11 @@ class MaterialReader {
   }
 
  private:
-  static bool is_coefficient(double x) { return std::isfinite(x) && x >= 0.0; }
+  // At most 1e6 mm^-1 (a mean free path of a nanometre): beyond it the models' exponentials and
+  // products overflow and no optical measurement could tell the difference.
+  static bool is_coefficient(double x) {
+    return std::isfinite(x) && x >= 0.0 && x <= kMaxCoefficient;
+  }
   static bool is_mean_cosine(double x) { return std::isfinite(x) && x > -1.0 && x < 1.0; }
 
   [[noreturn]] void fail(std::string_view field, const std::string& what) const {
@@ -242,12 +247,12 @@ class MaterialReader {
   }
 
   double read_ior() const {
-    const std::string expected = "a number in (0, 4] (n_sample / n_outside)";
+    const std::string expected = "a number in [0.25, 4] (n_sample / n_outside)";
     const json* ior = find("ior");
     if (!ior) fail("ior", "missing; expected " + expected);
     if (!ior->is_number()) fail("ior", "expected " + expected + ", found " + describe(*ior));
     const double x = ior->get<double>();
-    if (!(std::isfinite(x) && x > 0.0 && x <= 4.0)) {
+    if (!(std::isfinite(x) && x >= 0.25 && x <= 4.0)) {
       fail("ior", "expected " + expected + ", found " + describe(*ior));
     }
     return x;

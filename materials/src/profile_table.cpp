@@ -108,7 +108,8 @@ std::vector<double> parse_radius_list(const std::string& text, const std::string
     if (!parse_double(field, r)) {
       throw Error(option + ": expected a comma-separated list of radii in mm, got '" + field + "'");
     }
-    if (r < 0.0) throw Error(option + ": radius " + field + " mm is negative; expected r >= 0");
+    if (!(r >= 0.0 && r <= 1e6))
+      throw Error(option + ": radius " + field + " mm: expected a radius in [0, 1e6] mm");
     radii.push_back(r);
   }
   if (radii.empty()) throw Error(option + ": expected at least one radius in mm");
@@ -127,8 +128,8 @@ std::vector<double> parse_radius_range(const std::string& text, const std::strin
   }
   const std::string spacing = parts.size() == 4 ? parts[3] : "lin";
   if (spacing != "lin" && spacing != "log") throw Error(expected);
-  if (from < 0.0 || to < from) {
-    throw Error(option + ": expected 0 <= FROM <= TO (mm), got FROM=" + parts[0] +
+  if (from < 0.0 || to < from || to > 1e6) {
+    throw Error(option + ": expected 0 <= FROM <= TO <= 1e6 (mm), got FROM=" + parts[0] +
                 " TO=" + parts[1]);
   }
   if (count_value < 1.0 || count_value > 1e7 || std::floor(count_value) != count_value) {

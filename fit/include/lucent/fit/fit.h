@@ -90,6 +90,9 @@ struct ChannelFit {
   double start_sigma_a = 0, start_sigma_s_reduced = 0;
   int samples = 0;          ///< residuals used
   double residual_rms = 0;  ///< in standard errors
+  /// 1.4826 x median |residual|, standard errors: what decides whether the fit describes its data
+  /// (above 10 it does not, and the fit is not called converged).
+  double robust_residual_rms = 0;
   double chi2 = 0;
 };
 
