@@ -1,9 +1,11 @@
 // `lucent profile`: evaluate the standard or directional dipole and write CSV.
+#include <sstream>
 #include <fstream>
 #include <iostream>
 #include <memory>
 
 #include "commands.h"
+#include "lucent/materials/json_file.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
 #include "lucent/materials/profile_table.h"
@@ -31,8 +33,7 @@ void run_profile(const ProfileArguments& args) {
 
   std::string csv;
   if (!args.configs.empty()) {
-    std::ifstream in(args.configs);
-    if (!in) throw Error(args.configs + ": cannot open the configuration CSV");
+    std::istringstream in(read_input_file(args.configs));  // bounded, recorded as an input
     csv = bssrdf_configs_csv(material, model, read_bssrdf_configs(in, args.configs));
   } else {
     RadialProfileOptions options;

@@ -218,7 +218,8 @@ Profile profile_from_json(const json& doc, const std::string& source) {
   if (!capture.is_string()) in.fail("capture", "expected a string (the capture file)");
   p.capture = capture.get<std::string>();
   p.pixel_pitch_mm = in.number(in.get(doc, "pixel_pitch_mm", "pixel_pitch_mm"), "pixel_pitch_mm");
-  if (!(p.pixel_pitch_mm > 0)) in.fail("pixel_pitch_mm", "expected a pixel pitch > 0 mm");
+  if (!(p.pixel_pitch_mm >= 1e-6 && p.pixel_pitch_mm <= 100))
+    in.fail("pixel_pitch_mm", "expected a pixel pitch in [1e-6, 100] mm");
   const json& incidence = in.get(doc, "incidence", "incidence");
   if (!incidence.is_object()) in.fail("incidence", "expected {\"polar_deg\", \"azimuth_deg\"}");
   in.only_known(incidence, "incidence.", {"polar_deg", "azimuth_deg"});
@@ -229,7 +230,7 @@ Profile profile_from_json(const json& doc, const std::string& source) {
   p.view_deg = in.number(in.get(doc, "view_deg", "view_deg"), "view_deg");
   if (doc.contains("ior")) {
     p.ior = in.number(doc["ior"], "ior");
-    if (!(*p.ior > 0 && *p.ior <= 4)) in.fail("ior", "expected a relative index in (0, 4]");
+    if (!(*p.ior >= 0.25 && *p.ior <= 4)) in.fail("ior", "expected a relative index in [0.25, 4]");
   }
   const auto point = in.numbers(in.get(doc, "beam_point_px", "beam_point_px"), "beam_point_px", 2);
   p.beam_point_px = {point[0], point[1]};
@@ -243,7 +244,8 @@ Profile profile_from_json(const json& doc, const std::string& source) {
   if (!power.is_null()) {
     const auto values = in.numbers(power, "beam_power", 3);
     for (double v : values) {
-      if (!(v > 0)) in.fail("beam_power", "expected three powers > 0 (R, G, B) or null");
+      if (!(v >= 1e-30 && v <= 1e30))
+        in.fail("beam_power", "expected three powers in [1e-30, 1e30] (R, G, B) or null");
     }
     p.beam_power = std::array<double, 3>{values[0], values[1], values[2]};
   }

@@ -1,5 +1,7 @@
 #include "lucent/fit/fit_bench.h"
 
+#include "lucent/materials/json_file.h"
+
 #include <unistd.h>
 #include <algorithm>
 #include <chrono>
@@ -77,8 +79,7 @@ int run_fit_bench(const FitBenchOptions& options, std::ostream& log) {
   if (fs::exists(options.sample_capture)) {
     const fs::path acq = scratch / "sample-acq";
     acquire::run_acquire(options.sample_capture, acq);
-    std::ifstream truth_file(options.sample_capture.parent_path() / "truth.json");
-    const auto truth = nlohmann::json::parse(truth_file);
+    const auto truth = read_json_file(options.sample_capture.parent_path() / "truth.json");
     cases.push_back({"marble-montecarlo-0deg", load_profile_data(acq / "profile.json"),
                      materials::material_from_json(truth["material"], "truth.json")});
   } else {

@@ -1,6 +1,9 @@
 // The transport table file and the finishing of Monte Carlo group tallies (transport_table.h).
 #include "lucent/materials/transport_table.h"
 
+#include "lucent/materials/atomic_file.h"
+#include "lucent/materials/json_file.h"
+
 #include <zlib.h>
 
 #include <algorithm>
@@ -288,10 +291,11 @@ TransportTable read_transport_table(const std::filesystem::path& path) {
   }
   json h;
   try {
-    h = json::parse(header);
-  } catch (const std::exception&) {
-    throw Error(src + ": not a lucent-transport-table (the first line is not JSON)");
+    h = parse_json(header, src);
+  } catch (const Error&) {
+    throw Error(src + ": not a lucent-transport-table (the first line is not valid JSON)");
   }
+  note_input(path);
   const auto field = [&](const char* name) -> const json& {
     if (!h.is_object() || !h.contains(name)) throw Error(src + ": missing field '" + name + "'");
     return h.at(name);
