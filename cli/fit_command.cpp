@@ -90,6 +90,10 @@ fit::FitOptions to_options(const FitArguments& a) {
 
 void run(const FitArguments& a) {
   fit::FitOptions options = to_options(a);
+  // Where the outputs go is checked before the fit (they are written together at the end).
+  for (const std::string& out : {a.output, a.plot, a.report}) {
+    if (!out.empty()) check_output_folder(out);
+  }
   std::vector<fit::ProfileData> data;
   for (const std::string& input : a.inputs) {
     data.push_back(fit::load_profile_data(input));

@@ -82,7 +82,10 @@ void run(SimulateArguments& args) {
   o.camera.noise = !args.no_noise;
   o.white_reference = !args.no_white;
   o.dark_frame = !args.no_dark;
-  if (!args.exitance_csv.empty()) o.exitance_csv = args.exitance_csv;
+  if (!args.exitance_csv.empty()) {
+    check_output_folder(args.exitance_csv);  // before the simulation, not after it
+    o.exitance_csv = args.exitance_csv;
+  }
 
   const auto start = std::chrono::steady_clock::now();
   auto last = start;

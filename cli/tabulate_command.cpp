@@ -8,6 +8,7 @@
 
 #include "commands.h"
 #include "validators.h"
+#include "lucent/materials/atomic_file.h"
 #include "lucent/acquire/tabulate.h"
 #include "lucent/materials/error.h"
 #include "lucent/materials/profile_table.h"
@@ -51,6 +52,7 @@ std::string duration(double seconds) {
 }
 
 void run(TabulateArguments& args) {
+  check_output_folder(args.output);  // before hours of transport, not after
   if (!args.merge.empty()) {
     std::vector<materials::TransportTable> parts;
     for (const std::string& p : args.merge) parts.push_back(materials::read_transport_table(p));

@@ -224,6 +224,15 @@ void check_not_an_input(const fs::path& target) {
   check_not_an_input_locked(target, r);
 }
 
+void check_output_folder(const fs::path& path) {
+  const fs::path folder = folder_of(path);
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) {
+    throw Error(path.string() + ": cannot write: the folder " + folder.string() +
+                " does not exist");
+  }
+}
+
 void set_replace_folders(bool allow) {
   Registry& r = registry();
   std::lock_guard lock(r.mutex);

@@ -25,6 +25,10 @@ void note_input(const std::filesystem::path& path);
 /// Throws lucent::Error if writing `target` would replace an input this run read.
 void check_not_an_input(const std::filesystem::path& target);
 
+/// Throws lucent::Error "<path>: cannot write: the folder F does not exist" unless the folder that
+/// would hold `path` exists (commands call it first, so that a typo fails before the work).
+void check_output_folder(const std::filesystem::path& path);
+
 /// Writes `content` to `path` atomically. Text (binary = false) is checked first: a "nan" or
 /// "inf" number token is refused (lucent never writes one). Throws lucent::Error naming the path.
 void write_file_atomically(const std::filesystem::path& path, std::string_view content,

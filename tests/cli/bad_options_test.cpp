@@ -1,0 +1,230 @@
+// Bad-input table for the command-line options of every command (numbers with units, counts,
+// seeds, threads, enumerations, compound values, output paths), and the all-or-nothing outputs:
+// several files per command, existing folders, signals, temporaries of killed runs.
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
+
+#include "bad_input.h"
+
+namespace lucent::testing {
+namespace {
+
+std::vector<BadCase> option_cases() {
+  const std::string sim = "simulate --material marble --photons 1000 --size 16 -o {dir}/s ";
+  const std::string ren = "render --material marble --mesh sphere --technique reference "
+                          "--size 8x8 --samples-pixel 1 -o {dir}/r.exr ";
+  const std::string fit = "fit {world}/acq/profile.json -o {dir}/m.json ";
+  const std::string acq = "acquire {world}/cap/capture.json -o {dir}/a ";
+  const std::string pro = "profile --material marble -o {dir}/p.csv ";
+  const std::string tab = "tabulate -o {dir}/t.lut --photons 1000 ";
+  return {
+      // simulate: the camera and the transport
+      {"sim_full_well_zero", nullptr, sim + "--full-well-e 0", "--full-well-e"},
+      {"sim_camera_scale_nan", nullptr, sim + "--camera-scale nan", "--camera-scale"},
+      {"sim_read_noise_negative", nullptr, sim + "--read-noise-e -5", "--read-noise-e"},
+      {"sim_black_level_huge", nullptr, sim + "--black-level-e 1e9", "--black-level-e"},
+      {"sim_black_level_over_well", nullptr, sim + "--black-level-e 30000", "--black-level-e"},
+      {"sim_seed_negative", nullptr, sim + "--seed -1", "--seed"},
+      {"sim_seed_fraction", nullptr, sim + "--seed 1.5", "--seed"},
+      {"sim_seed_too_big", nullptr, sim + "--seed 18446744073709551616", "--seed"},
+      {"sim_photons_one", nullptr, sim + "--photons 1", "--photons"},
+      {"sim_threads_huge", nullptr, sim + "--threads 100000", "--threads"},
+      {"sim_threads_negative", nullptr, sim + "--threads -1", "--threads"},
+      {"sim_size_zero", nullptr, sim + "--size 0", "--size"},
+      {"sim_pixel_nan", nullptr, sim + "--pixel-mm nan", "--pixel-mm"},
+      {"sim_max_radius_overflow", nullptr, sim + "--max-radius-mm 1e400", "--max-radius-mm"},
+      {"sim_bits_12", nullptr, sim + "--bits 12", "--bits"},
+      {"sim_exposure_zero", nullptr, sim + "--exposures 1/0", "--exposures"},
+      {"sim_exposures_decreasing", nullptr, sim + "--exposures 1/10,1/100", "--exposures"},
+      {"sim_response_foo", nullptr, sim + "--response foo", "--response"},
+      {"sim_source_foo", nullptr, sim + "--source foo", "--source"},
+      {"sim_incidence_95", nullptr, sim + "--incidence-deg 95", "incidence"},
+      {"sim_material_missing", nullptr, "simulate --material {dir}/none.json -o {dir}/s",
+       "none.json"},
+      {"sim_exitance_csv_folder_missing", nullptr, sim + "--exitance-csv {dir}/nodir/x.csv",
+       "nodir"},
+      {"sim_output_exists",
+       [](const fs::path& d) {
+         fs::create_directories(d / "s");
+         write_file(d / "s/bracket_9.png", "an earlier capture's");
+       },
+       sim, "--force"},
+      // render / view scene options
+      {"render_threads_negative", nullptr, ren + "--threads -1", "--threads"},
+      {"render_seed_word", nullptr, ren + "--seed abc", "--seed"},
+      {"render_view_far", nullptr, ren + "--view 0,0,1e20", "--view"},
+      {"render_view_two_numbers", nullptr, ren + "--view 0,0", "--view"},
+      {"render_size_zero", nullptr, ren.substr(0, ren.find("--size")) + "--size 0x0 -o {dir}/r.exr",
+       "--size"},
+      {"render_object_size_huge", nullptr, ren + "--object-size-mm 1e308", "--object-size-mm"},
+      {"render_light_kind", nullptr, ren + "--light spot:0,1,0:1,1,1", "--light"},
+      {"render_light_1e38", nullptr, ren + "--light directional:0,1,0:1e38,1,1", "--light"},
+      {"render_light_far", nullptr, ren + "--light point:1e30,0,0:1,1,1", "--light"},
+      {"render_light_zero_direction", nullptr, ren + "--light directional:0,0,0:1,1,1",
+       "--light"},
+      {"render_backdrop_negative", nullptr, ren + "--backdrop -1,0,0", "--backdrop"},
+      {"render_exposure_zero", nullptr, ren + "--exposure 0", "--exposure"},
+      {"render_roughness_two", nullptr, ren + "--roughness 2", "--roughness"},
+      {"render_technique_foo", nullptr, ren + "--technique foo", "--technique"},
+      {"render_model_foo", nullptr, ren + "--model foo", "--model"},
+      {"render_sampling_foo", nullptr, ren + "--reference-sampling foo", "--reference-sampling"},
+      {"render_samples_zero", nullptr, ren + "--samples-pixel 0", "--samples-pixel"},
+      {"render_passes_zero", nullptr, ren + "--passes 0", "--passes"},
+      {"render_stats_folder_missing", nullptr, ren + "--stats {dir}/nodir/s.json", "nodir"},
+      {"render_output_folder_missing", nullptr,
+       ren.substr(0, ren.find("-o ")) + "-o {dir}/nodir/r.exr", "nodir"},
+      // fit
+      {"fit_exclude_nan", nullptr, fit + "--exclude-radius-mm nan", "--exclude-radius-mm"},
+      {"fit_exclude_negative", nullptr, fit + "--exclude-radius-mm -1", "--exclude-radius-mm"},
+      {"fit_ior_zero", nullptr, fit + "--ior 0", "--ior"},
+      {"fit_ior_five", nullptr, fit + "--ior 5", "--ior"},
+      {"fit_g_099", nullptr, fit + "--g 0.99", "--g"},
+      {"fit_loss_trailing_garbage", nullptr, fit + "--loss huber:1abc", "--loss"},
+      {"fit_loss_foo", nullptr, fit + "--loss foo", "--loss"},
+      {"fit_quality_foo", nullptr, fit + "--quality foo", "--quality"},
+      {"fit_model_foo", nullptr, fit + "--model foo", "--model"},
+      {"fit_table_missing", nullptr, fit + "--table {dir}/none.lut", "none.lut"},
+      {"fit_plot_folder_missing", nullptr, fit + "--plot {dir}/nodir/f.png", "nodir"},
+      // acquire
+      {"acquire_bins_zero", nullptr, acq + "--bins 0", "--bins"},
+      {"acquire_bins_negative", nullptr, acq + "--bins -3", "--bins"},
+      {"acquire_radius_overflow", nullptr, acq + "--radius-mm 1e400", "--radius-mm"},
+      {"acquire_radius_max_double", nullptr, acq + "--radius-mm 1.7976931348623157e308",
+       "(0, 1e+06] mm"},
+      {"acquire_min_pixels_one", nullptr, acq + "--min-pixels 1", "--min-pixels"},
+      // profile
+      {"profile_r_huge", nullptr, pro + "--r 1e308", "--r"},
+      {"profile_r_negative", nullptr, pro + "--r -1", "--r"},
+      {"profile_range_backwards", nullptr, pro + "--r-range 5:1:10", "--r-range"},
+      {"profile_quantity_foo", nullptr, pro + "--r 1 --quantity foo", "--quantity"},
+      {"profile_model_foo", nullptr, pro + "--r 1 --model foo", "--model"},
+      // tabulate, compare
+      {"tabulate_seed_negative", nullptr, tab + "--seed -1", "--seed"},
+      {"tabulate_threads_huge", nullptr, tab + "--threads 5000", "--threads"},
+      {"compare_scale_word", nullptr, "compare {world}/env.exr {world}/env.exr --scale x",
+       "--scale"},
+      // the command line itself
+      {"unknown_option", nullptr, "fit {world}/acq/profile.json -o {dir}/m.json --colour red",
+       "--colour"},
+      {"no_subcommand", nullptr, "", "subcommand"},
+  };
+}
+
+class BadOptions : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(BadOptions, AreRefusedCleanly) { expect_clean_refusal(GetParam()); }
+
+INSTANTIATE_TEST_SUITE_P(Table, BadOptions, ::testing::ValuesIn(option_cases()),
+                         [](const auto& info) { return info.param.name; });
+
+// ---- all or nothing -----------------------------------------------------------------------------
+
+std::string quoted(const fs::path& p) { return "\"" + p.string() + "\""; }
+
+TEST(Outputs, AnExistingFolderIsReplacedWholeOnlyWithForce) {
+  const fs::path dir = scratch_dir("force");
+  const std::string sim = "simulate --material marble --photons 1000 --size 16 --quiet -o " +
+                          quoted(dir / "s");
+  ASSERT_EQ(run_lucent(sim).exit_code, 0);
+  ASSERT_TRUE(fs::exists(dir / "s/white_0.png"));
+  // The second capture has no white reference: with --force nothing of the first may remain.
+  const CommandResult r = run_lucent(sim + " --no-white-reference --force");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "s/white_0.png"));
+  EXPECT_TRUE(fs::exists(dir / "s/capture.json"));
+  for (const auto& e : fs::directory_iterator(dir)) {
+    EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
+  }
+  fs::remove_all(dir);
+}
+
+TEST(Outputs, TheSeedDrivesTheCameraNoiseAndIsRecorded) {
+  const fs::path dir = scratch_dir("seeds");
+  for (const char* seed : {"1", "2"}) {
+    ASSERT_EQ(run_lucent("simulate --material marble --photons 1000 --size 16 --quiet --seed " +
+                         std::string(seed) + " -o " + quoted(dir / seed))
+                  .exit_code,
+              0);
+  }
+  const auto truth = nlohmann::json::parse(read_bytes(dir / "2/truth.json"));
+  EXPECT_EQ(truth["transport"]["seed"], 2);
+  EXPECT_EQ(truth["camera"]["seed"], 2);
+  // A dipole source has no transport noise: the brackets differ only by the camera's.
+  const std::string dipole = "simulate --material marble --source dipole --size 16 --quiet ";
+  ASSERT_EQ(run_lucent(dipole + "--seed 1 -o " + quoted(dir / "d1")).exit_code, 0);
+  ASSERT_EQ(run_lucent(dipole + "--seed 2 -o " + quoted(dir / "d2")).exit_code, 0);
+  ASSERT_EQ(run_lucent(dipole + "--seed 2 -o " + quoted(dir / "d2b")).exit_code, 0);
+  EXPECT_NE(read_bytes(dir / "d1/bracket_2.png"), read_bytes(dir / "d2/bracket_2.png"));
+  EXPECT_EQ(read_bytes(dir / "d2/bracket_2.png"), read_bytes(dir / "d2b/bracket_2.png"));
+  fs::remove_all(dir);
+}
+
+// Starts lucent in the background; returns its pid.
+pid_t spawn_lucent(const std::string& args, const fs::path& log) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const std::string command = std::string("exec \"") + LUCENT_BINARY + "\" " + args + " >" +
+                                quoted(log) + " 2>&1 </dev/null";
+    ::execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  return pid;
+}
+
+bool has_temporary(const fs::path& dir) {
+  for (const auto& e : fs::directory_iterator(dir)) {
+    if (e.path().filename().string().find(".tmp-") != std::string::npos) return true;
+  }
+  return false;
+}
+
+// Waits (up to 60 s) until lucent has a temporary in `dir`, i.e. is in the middle of its work.
+bool wait_for_temporary(const fs::path& dir) {
+  for (int i = 0; i < 600; ++i) {
+    if (has_temporary(dir)) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return false;
+}
+
+TEST(Outputs, SigintAndSigtermLeaveNothingBehind) {
+  for (const int sig : {SIGTERM, SIGINT}) {
+    const fs::path dir = scratch_dir("signal-" + std::to_string(sig));
+    const pid_t pid = spawn_lucent("simulate --material marble --photons 200000000 --threads 1 "
+                                   "--quiet -o " + quoted(dir / "s"),
+                                   dir.parent_path() / ("signal-log-" + std::to_string(sig)));
+    ASSERT_TRUE(wait_for_temporary(dir)) << "no temporary folder appeared";
+    ::kill(pid, sig);
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == sig) << "status " << status;
+    EXPECT_FALSE(has_temporary(dir));
+    EXPECT_FALSE(fs::exists(dir / "s"));
+    fs::remove_all(dir);
+  }
+}
+
+TEST(Outputs, TemporariesOfAKilledRunAreRemovedByTheNextRun) {
+  const fs::path dir = scratch_dir("sigkill");
+  const pid_t pid = spawn_lucent("simulate --material marble --photons 200000000 --threads 1 "
+                                 "--quiet -o " + quoted(dir / "s"),
+                                 dir.parent_path() / "sigkill-log");
+  ASSERT_TRUE(wait_for_temporary(dir));
+  ::kill(pid, SIGKILL);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(has_temporary(dir));  // nothing can clean up after SIGKILL ...
+  const CommandResult r =
+      run_lucent("profile --material marble --r 1 -o " + quoted(dir / "p.csv"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(has_temporary(dir));  // ... but the next run writing here does
+  EXPECT_TRUE(fs::exists(dir / "p.csv"));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace lucent::testing
