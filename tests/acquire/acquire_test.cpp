@@ -23,6 +23,7 @@
 #include "lucent/acquire/profile.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
+#include "raw_exr.h"
 
 namespace lucent::acquire {
 namespace {
@@ -407,7 +408,7 @@ TEST(HdrMerge, HdrInputMasksNonFinitePixels) {
   image.at(3, 4, 0) = std::numeric_limits<float>::quiet_NaN();
   image.at(5, 6, 1) = std::numeric_limits<float>::infinity();
   image.at(7, 8, 2) = -std::numeric_limits<float>::infinity();
-  write_exr(dir / "hdr.exr", image);
+  lucent::testing::write_raw_exr(dir / "hdr.exr", image);  // NaN on purpose
   ImageSet set;
   set.hdr = "hdr.exr";
   const HdrResult hdr = merge_brackets(set, Response::kLinear, std::nullopt, dir);
@@ -1005,7 +1006,7 @@ TEST(AcquireBadInput, NonFinitePixelsAreMaskedAndReportedUnlessEveryPixelIs) {
   ImageRgb image = spot_radiance(Spot{});
   for (int x = 0; x < 6; ++x) image.at(x, 60, 1) = std::numeric_limits<float>::quiet_NaN();
   image.at(50, 10, 0) = std::numeric_limits<float>::infinity();
-  write_exr(dir / "sample.exr", image);
+  lucent::testing::write_raw_exr(dir / "sample.exr", image);  // NaN on purpose
   ImageSet set;
   set.hdr = "sample.exr";
   const fs::path capture = write_capture_file(dir, make_capture(set, 0.1, Response::kLinear));
@@ -1015,7 +1016,8 @@ TEST(AcquireBadInput, NonFinitePixelsAreMaskedAndReportedUnlessEveryPixelIs) {
   EXPECT_EQ(profile.masked.non_finite, (std::array<std::int64_t, 3>{1, 6, 0}));
   EXPECT_NEAR(summary.beam_point_px[0], 30.3, 0.05);
 
-  write_exr(dir / "nan.exr", ImageRgb(64, 64, std::numeric_limits<float>::quiet_NaN()));
+  lucent::testing::write_raw_exr(dir / "nan.exr",
+                                 ImageRgb(64, 64, std::numeric_limits<float>::quiet_NaN()));
   set.hdr = "nan.exr";
   expect_acquire_fails(
       write_capture_file(dir, make_capture(set, 0.1, Response::kLinear), "nan.json"),

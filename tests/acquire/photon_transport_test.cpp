@@ -503,7 +503,7 @@ void expect_rejected(const PhotonTransportOptions& o, const std::string& option)
 }
 
 TEST(PhotonTransport, BadOptionsAreRejectedByName) {
-  const PhotonTransportOptions good = one_channel({0.1, 1.0, 0.0, 1.3}, 10);
+  const PhotonTransportOptions good = one_channel({0.1, 1.0, 0.0, 1.3}, 100);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   auto with = [&](auto change) {
     PhotonTransportOptions o = good;

@@ -1,9 +1,5 @@
 // Bad-input tables for lucent's images and meshes: exposure brackets (PNG), OpenEXR and Radiance
 // images (captures, comparisons, environment maps) and PLY/OBJ meshes. See bad_input.h.
-#include <ImfChannelList.h>
-#include <ImfFrameBuffer.h>
-#include <ImfHeader.h>
-#include <ImfOutputFile.h>
 
 #include <cmath>
 #include <cstdint>
@@ -11,6 +7,7 @@
 
 #include "bad_input.h"
 #include "lucent/acquire/image_io.h"
+#include "raw_exr.h"
 
 namespace lucent::testing {
 namespace {
@@ -18,26 +15,16 @@ namespace {
 // ---- helpers ------------------------------------------------------------------------------------
 
 // An EXR with any values, NaN included (lucent's own writer refuses non-finite pixels).
-void write_raw_exr(const fs::path& path, int w, int h, float value, float special = 0,
+void write_exr_with(const fs::path& path, int w, int h, float value, float special = 0,
                    bool with_special = false) {
-  std::vector<float> rgb(std::size_t(w) * h * 3, value);
-  if (with_special) rgb[3 * (std::size_t(w) * h / 2)] = special;
-  Imf::Header header(w, h);
-  for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
-  Imf::OutputFile file(path.c_str(), header);
-  Imf::FrameBuffer frame;
-  char* base = reinterpret_cast<char*>(rgb.data());
-  const char* names[3] = {"R", "G", "B"};
-  for (int c = 0; c < 3; ++c)
-    frame.insert(names[c],
-                 Imf::Slice(Imf::FLOAT, base + c * sizeof(float), 12, 12 * std::size_t(w)));
-  file.setFrameBuffer(frame);
-  file.writePixels(h);
+  acquire::ImageRgb image(w, h, value);
+  if (with_special) image.data[3 * (std::size_t(w) * h / 2)] = special;
+  lucent::testing::write_raw_exr(path, image);
 }
 
 std::function<void(const fs::path&)> exr_file(std::string name, float value, float special = 0,
                                               bool with_special = false) {
-  return [=](const fs::path& d) { write_raw_exr(d / name, 16, 8, value, special, with_special); };
+  return [=](const fs::path& d) { write_exr_with(d / name, 16, 8, value, special, with_special); };
 }
 
 void write_png_of(const fs::path& path, int w, int h, int max, std::uint16_t value) {
@@ -165,7 +152,7 @@ std::vector<BadCase> image_cases() {
        cmp, "a.exr"},
       {"exr_directory", [](const fs::path& d) { fs::create_directory(d / "a.exr"); }, cmp,
        "a.exr"},
-      {"exr_size_mismatch", [](const fs::path& d) { write_raw_exr(d / "a.exr", 8, 8, 0.5f); },
+      {"exr_size_mismatch", [](const fs::path& d) { write_exr_with(d / "a.exr", 8, 8, 0.5f); },
        cmp, "size"},
       {"env_nan", exr_file("e.exr", 0.5f, std::nanf(""), true), env + "{dir}/e.exr", "e.exr"},
       {"env_inf", exr_file("e.exr", 0.5f, INFINITY, true), env + "{dir}/e.exr", "e.exr"},

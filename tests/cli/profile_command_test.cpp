@@ -139,7 +139,7 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         BadInput{"unknown_material", "profile --material unobtainium --r 1 -o {OUT}",
                  "unknown material 'unobtainium'"},
-        BadInput{"negative_r", "profile --material marble --r 1,-2 -o {OUT}", "negative"},
+        BadInput{"negative_r", "profile --material marble --r 1,-2 -o {OUT}", "[0, 1e6] mm"},
         BadInput{"r_not_number", "profile --material marble --r 1,abc -o {OUT}", "--r: expected"},
         BadInput{"bad_range", "profile --material marble --r-range 0:10:5:log -o {OUT}",
                  "log spacing needs FROM > 0"},
