@@ -34,10 +34,11 @@ void write_hdr(const fs::path& path, int width, int height, float value) {
   write_file(path, bytes);
 }
 
-fs::path make_world() {
-  const fs::path w = fs::temp_directory_path() / ("lucent-bad-input-world-" +
-                                                  std::to_string(::getpid()));
-  fs::remove_all(w);
+// Built into a private folder, then renamed into place: ctest runs every case as its own process,
+// so the first process builds the world and the others (in parallel too) reuse it. The name holds
+// the lucent binary's modification time: a rebuilt lucent gets a new world.
+// `final` is where `w` will be renamed to: the absolute paths written into files name it.
+fs::path make_world_in(const fs::path& w, const fs::path& final) {
   fs::create_directories(w);
   const fs::path src = LUCENT_SOURCE_DIR;
   fs::copy_file(src / "materials/library/marble.json", w / "marble.json");
@@ -46,9 +47,10 @@ fs::path make_world() {
   // The capture with absolute image paths, so that a case's copy may live in any folder.
   Json cap = read_json(w / "cap/capture.json");
   for (auto* images : {&cap["images"], &cap["white_reference"]["images"]}) {
-    for (auto& image : *images) image["path"] = (w / "cap" / image["path"].get<std::string>()).string();
+    for (auto& image : *images)
+      image["path"] = (final / "cap" / image["path"].get<std::string>()).string();
   }
-  cap["dark"] = (w / "cap" / cap["dark"].get<std::string>()).string();
+  cap["dark"] = (final / "cap" / cap["dark"].get<std::string>()).string();
   write_file(w / "capture_abs.json", cap.dump(2));
   run_or_die("acquire \"" + (w / "cap/capture.json").string() + "\" -o \"" + (w / "acq").string() +
              "\" --bins 60");
@@ -60,6 +62,20 @@ fs::path make_world() {
   acquire::ImageRgb env(16, 8, 0.5f);
   acquire::write_exr(w / "env.exr", env);
   write_hdr(w / "env.hdr", 16, 8, 0.5f);
+  return w;
+}
+
+fs::path make_world() {
+  const auto stamp = fs::last_write_time(LUCENT_BINARY).time_since_epoch().count();
+  const fs::path w = fs::temp_directory_path() / ("lucent-bad-input-world-" + std::to_string(stamp));
+  if (fs::exists(w / "complete")) return w;
+  const fs::path mine = w.string() + ".building-" + std::to_string(::getpid());
+  fs::remove_all(mine);
+  make_world_in(mine, w);
+  write_file(mine / "complete", "");
+  std::error_code ec;
+  fs::rename(mine, w, ec);  // fails when another process got there first: use theirs
+  if (ec) fs::remove_all(mine);
   return w;
 }
 
