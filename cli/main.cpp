@@ -1,5 +1,6 @@
 #include <exception>
 #include <iostream>
+#include <new>
 
 #include "commands.h"
 #include "lucent/materials/atomic_file.h"
@@ -47,6 +48,10 @@ int main(int argc, char** argv) {
     return 2;
   } catch (const lucent::Error& e) {
     std::cerr << "lucent: error: " << e.what() << '\n';
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "lucent: error: out of memory (an input or a setting asks for more memory than "
+                 "this machine has)\n";
     return 1;
   } catch (const std::exception& e) {
     std::cerr << "lucent: internal error: " << e.what() << '\n';

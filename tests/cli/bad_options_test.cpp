@@ -163,6 +163,15 @@ TEST(Outputs, TheSeedDrivesTheCameraNoiseAndIsRecorded) {
   fs::remove_all(dir);
 }
 
+TEST(Outputs, EverySubcommandAnswersVersion) {
+  for (const char* sub : {"profile", "simulate", "acquire", "fit", "bench", "render", "view",
+                          "tabulate", "compare"}) {
+    const CommandResult r = run_lucent(std::string(sub) + " --version");
+    EXPECT_EQ(r.exit_code, 0) << sub << ": " << r.err;
+    EXPECT_EQ(r.out.rfind("lucent ", 0), 0u) << sub << ": " << r.out;
+  }
+}
+
 // Starts lucent in the background; returns its pid.
 pid_t spawn_lucent(const std::string& args, const fs::path& log) {
   const pid_t pid = ::fork();
