@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "commands.h"
+#include "lucent/materials/atomic_file.h"
 #include "lucent/fit/fit_bench.h"
 #include "lucent/render/render_bench.h"
 
@@ -27,6 +28,7 @@ void register_bench_command(CLI::App& app) {
   fit_cmd->add_option("--size", options->size_px, "simulated captures' size, pixels")
       ->capture_default_str();
   fit_cmd->callback([options] {
+    check_output_folder(options->out_dir / "fit_tradeoff.csv");  // before the sweep, not after
     const int n = fit::run_fit_bench(*options, std::cout);
     std::cout << "bench fit: " << n << " settings; wrote "
               << (options->out_dir / "fit_tradeoff.csv").string() << " and fit_tradeoff.png\n";
@@ -53,6 +55,7 @@ void register_bench_command(CLI::App& app) {
   render_cmd->add_option("--disc-selection", *selections, "disc selections to time (rows each)")
       ->capture_default_str();
   render_cmd->callback([render_options, selections] {
+    check_output_folder(render_options->out_csv);  // before the sweep, not after
     render_options->disc_selections.clear();
     for (const auto& text : *selections) {
       render_options->disc_selections.push_back(render::parse_disc_selection(text));

@@ -48,8 +48,9 @@ void run_view(ViewArguments& args) {
   if (!args.scene.default_rig.empty()) {
     std::string rig;
     for (const auto& light : args.scene.default_rig) rig += " --light " + light;
-    std::fprintf(stderr, "view: no --light or --env: the default rig (key, fill, rim):%s\n",
-                 rig.c_str());
+    // On stdout with the viewer's other news: stderr is for the one line of a failure.
+    std::printf("view: no --light or --env: the default rig (key, fill, rim):%s\n", rig.c_str());
+    std::fflush(stdout);
   }
   const int status = render::run_viewer(options);
   if (status != 0) std::exit(status);

@@ -20,13 +20,15 @@ void require(bool ok, const std::string& option, const std::string& what, double
 }  // namespace
 
 void RenderSettings::validate() const {
-  require(frames >= 1, "--frames", "must be at least 1", frames);
+  // The upper bounds keep a typo from running for days or allocating what no GPU has.
+  require(frames >= 1 && frames <= 100000, "--frames", "must be 1..100000", frames);
   require(directions >= 1 && directions <= 256, "--directions", "must be 1..256", directions);
-  require(samples >= 1, "--samples", "must be at least 1", samples);
-  require(disc_points >= 1, "--disc-points", "must be at least 1", disc_points);
+  require(samples >= 1 && samples <= 65536, "--samples", "must be 1..65536", samples);
+  require(disc_points >= 1 && disc_points <= 1048576, "--disc-points", "must be 1..1048576",
+          disc_points);
   require(samples <= disc_points, "--samples",
           "must not exceed --disc-points (" + std::to_string(disc_points) + ")", samples);
-  require(std::isfinite(q) && q > 0, "--q", "must be positive", q);
+  require(std::isfinite(q) && q > 0 && q <= 1000, "--q", "must be in (0, 1000]", q);
   require(radiance_map_size >= 8 && radiance_map_size <= 8192, "--radiance-map",
           "must be 8..8192 texels", radiance_map_size);
   require(light_map_size >= 8 && light_map_size <= 8192, "--light-map", "must be 8..8192 texels",

@@ -107,6 +107,30 @@ std::vector<BadCase> option_cases() {
       {"tabulate_threads_huge", nullptr, tab + "--threads 5000", "--threads"},
       {"compare_scale_word", nullptr, "compare {world}/env.exr {world}/env.exr --scale x",
        "--scale"},
+      // long jobs refuse before they start
+      {"bench_render_folder_missing", nullptr, "bench render --out {dir}/nodir/r.csv", "nodir"},
+      {"bench_fit_folder_missing", nullptr, "bench fit --out-dir {dir}/nodir", "nodir"},
+      {"render_frames_huge", nullptr, "render --material marble --size 8x8 -o {dir}/r.exr --frames 1000000000",
+       "--frames"},
+      {"render_disc_points_huge", nullptr,
+       "render --material marble --size 8x8 -o {dir}/r.exr --disc-points 100000000",
+       "--disc-points"},
+      {"tabulate_eta_low", nullptr, tab + "--eta 0.5", "--eta"},
+      {"tabulate_merge_garbage", bytes_file("bad.lut", "garbage\n"),
+       "tabulate -o {dir}/t.lut --merge {dir}/bad.lut", "bad.lut"},
+      {"fit_table_garbage", bytes_file("bad.lut", "garbage\n"), fit + "--table {dir}/bad.lut",
+       "bad.lut"},
+      {"fit_table_truncated",
+       [](const fs::path& d) {
+         const std::string t = read_bytes(fs::path(LUCENT_SOURCE_DIR) / "materials/tables/transport.lut");
+         write_file(d / "t.lut", t.substr(0, 5000));
+       },
+       fit + "--table {dir}/t.lut", "t.lut"},
+      {"profile_range_count_zero", nullptr, pro + "--r-range 0:1:0", "--r-range"},
+      {"profile_range_spacing", nullptr, pro + "--r-range 0:1:10:cubic", "--r-range"},
+      {"sim_thickness_negative", nullptr, sim + "--thickness-mm -1", "thickness"},
+      {"acquire_profile_as_capture", nullptr, "acquire {world}/acq/profile.json -o {dir}/a",
+       "profile.json"},
       // the command line itself
       {"unknown_option", nullptr, "fit {world}/acq/profile.json -o {dir}/m.json --colour red",
        "--colour"},
