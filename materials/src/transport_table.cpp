@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -279,7 +280,42 @@ void write_transport_table(const TransportTable& t, const std::filesystem::path&
   write_file_atomically(path, h.dump() + "\n" + payload, /*binary=*/true);
 }
 
+namespace {
+
+// A header's whole number as T, or a lucent::Error (nlohmann's get<int>() of 1e30 is undefined
+// behaviour, of -1 as uint64 a wrap).
+template <class T>
+T whole_number(const json& v, const std::string& src, const char* name) {
+  bool ok = v.is_number_integer();
+  if (ok && v.is_number_unsigned()) {
+    ok = v.get<std::uint64_t>() <= static_cast<std::uint64_t>(std::numeric_limits<T>::max());
+  } else if (ok) {
+    const std::int64_t i = v.get<std::int64_t>();
+    ok = i >= static_cast<std::int64_t>(std::numeric_limits<T>::min()) &&
+         (i < 0 || static_cast<std::uint64_t>(i) <=
+                       static_cast<std::uint64_t>(std::numeric_limits<T>::max()));
+  }
+  if (!ok) throw Error(src + ": " + name + ": expected a whole number in range, found " + v.dump());
+  return v.is_number_unsigned() ? static_cast<T>(v.get<std::uint64_t>())
+                                : static_cast<T>(v.get<std::int64_t>());
+}
+
+TransportTable read_transport_table_unchecked(const std::filesystem::path& path);
+
+}  // namespace
+
 TransportTable read_transport_table(const std::filesystem::path& path) {
+  try {
+    return read_transport_table_unchecked(path);
+  } catch (const json::exception& e) {
+    throw Error(path.string() + ": not a valid lucent-transport-table header (" +
+                std::string(e.what()) + ")");
+  }
+}
+
+namespace {
+
+TransportTable read_transport_table_unchecked(const std::filesystem::path& path) {
   const std::string src = path.string();
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(src + ": cannot open the transport table");
@@ -309,15 +345,15 @@ TransportTable read_transport_table(const std::filesystem::path& path) {
     t.grid.u = g.at("u").get<std::vector<double>>();
     t.grid.rho_min = g.at("rho_min").get<double>();
     t.grid.rho_max = g.at("rho_max").get<double>();
-    t.grid.rho_per_decade = g.at("rho_per_decade").get<int>();
-    t.groups = field("groups").get<int>();
-    t.seed = field("seed").get<std::uint64_t>();
+    t.grid.rho_per_decade = whole_number<int>(g.at("rho_per_decade"), src, "rho_per_decade");
+    t.groups = whole_number<int>(field("groups"), src, "groups");
+    t.seed = whole_number<std::uint64_t>(field("seed"), src, "seed");
     t.max_path = field("max_path").get<double>();
     t.generator = field("generator").get<std::string>();
     t.partial = field("kind").get<std::string>() == "partial";
     for (const json& s : field("slices"))
       t.slice_axes.push_back({s.at("eta").get<double>(), s.at("g").get<double>(),
-                              double(s.at("photons").get<std::uint64_t>())});
+                              double(whole_number<std::uint64_t>(s.at("photons"), src, "photons"))});
   } catch (const json::exception& e) {
     throw Error(src + ": grid, slices or groups: unexpected value (" + std::string(e.what()) + ")");
   }
@@ -333,13 +369,13 @@ TransportTable read_transport_table(const std::filesystem::path& path) {
       throw Error(src + ": slices: eta in [1, 2.5], g in [0, 1) and photons >= 1 expected");
 
   std::string payload((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::uint64_t declared = field("payload_bytes").get<std::uint64_t>();
+  const std::uint64_t declared = whole_number<std::uint64_t>(field("payload_bytes"), src, "payload_bytes");
   if (payload.size() != declared)
     throw Error(src + ": payload_bytes: the header says " + std::to_string(declared) +
                 " bytes, the file holds " + std::to_string(payload.size()));
   const std::uint64_t crc =
       crc32(0L, reinterpret_cast<const Bytef*>(payload.data()), uInt(payload.size()));
-  if (crc != field("crc32").get<std::uint64_t>())
+  if (crc != whole_number<std::uint64_t>(field("crc32"), src, "crc32"))
     throw Error(src + ": crc32: the payload is corrupt (checksum mismatch)");
 
   const std::size_t K = t.grid.u.size(), n = t.grid.entries();
@@ -366,7 +402,8 @@ TransportTable read_transport_table(const std::filesystem::path& path) {
     t.shard = h.value("shard", "");
     for (const json& gj : field("partial_groups")) {
       TransportTableGroup g;
-      g.slice = gj.at(0).get<int>(), g.group = gj.at(1).get<int>();
+      g.slice = whole_number<int>(gj.at(0), src, "partial_groups"),
+      g.group = whole_number<int>(gj.at(1), src, "partial_groups");
       if (g.slice < 0 || std::size_t(g.slice) >= t.slice_axes.size() || g.group < 0 ||
           g.group >= t.groups)
         throw Error(src + ": partial_groups: (slice, group) out of range");
@@ -382,6 +419,8 @@ TransportTable read_transport_table(const std::filesystem::path& path) {
   if (r.left() != 0) throw Error(src + ": payload: trailing bytes after the declared content");
   return t;
 }
+
+}  // namespace
 
 TransportTable merge_transport_tables(const std::vector<TransportTable>& parts) {
   if (parts.empty()) throw Error("merge: no tables given");

@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <optional>
@@ -153,8 +154,9 @@ class BodyReader {
 unsigned vertex_index(double v, std::size_t vertices, const std::string& source,
                       const std::string& where) {
   if (!(v >= 0) || v >= static_cast<double>(vertices)) {
-    throw Error(source + ": " + where + ": vertex index " + std::to_string(static_cast<long long>(
-                    std::isfinite(v) ? v : -1)) +
+    char text[32];
+    std::snprintf(text, sizeof text, "%.15g", v);  // any double: no cast of an out-of-range value
+    throw Error(source + ": " + where + ": vertex index " + text +
                 " is out of range (the file has " + std::to_string(vertices) + " vertices)");
   }
   return static_cast<unsigned>(v);

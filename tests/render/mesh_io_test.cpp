@@ -89,6 +89,9 @@ std::vector<BadMesh> bad_meshes() {
       {"nan_vertex", true, replaced(a, "\n0 0 0\n", "\nnan 0 0\n"), "not finite"},
       {"inf_vertex", true, replaced(a, "\n0 0 0\n", "\n1e999 0 0\n"), "vertex 0"},
       {"index_out_of_range", true, replaced(a, "4 0 1 3 2", "4 0 1 3 8"), "out of range"},
+      // Found by fuzz_mesh_loader: an index beyond every integer type (UBSan: float-cast-overflow).
+      {"index_beyond_long_long", true, replaced(a, "4 2 3 7 6", "4 2 3 7 6222222222222222222222222222"),
+       "out of range"},
       {"negative_index", true, replaced(a, "4 0 1 3 2", "4 0 1 3 -1"), "out of range"},
       {"fraction_index", true, replaced(a, "4 0 1 3 2", "4 0 1 3 2.5"), "integer"},
       {"word_in_body", true, replaced(a, "\n1 1 1\n", "\n1 one 1\n"), "expected a number"},
