@@ -183,7 +183,8 @@ void finish(const fs::path& temporary, const fs::path& target, bool folder) {
 }
 
 // A number token that is not finite: nan, -nan, inf, +inf, infinity (any case), as text writers
-// print them. Words that merely contain these letters ("info", "infinite") are not tokens.
+// print them. Words that merely contain these letters ("info", "infinite") are not tokens, and
+// comment lines ('#': names, units, provenance, from validated values) are not searched.
 std::size_t find_non_finite_token(std::string_view text) {
   auto is_separator = [](char c) {
     return c == ',' || c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '=' || c == ':' ||
@@ -192,6 +193,11 @@ std::size_t find_non_finite_token(std::string_view text) {
   std::size_t i = 0;
   while (i < text.size()) {
     while (i < text.size() && is_separator(text[i])) ++i;
+    if (i < text.size() && text[i] == '#' && (i == 0 || text[i - 1] == '\n')) {
+      const std::size_t eol = text.find('\n', i);
+      i = eol == std::string_view::npos ? text.size() : eol + 1;
+      continue;
+    }
     std::size_t j = i;
     while (j < text.size() && !is_separator(text[j])) ++j;
     std::string token(text.substr(i, j - i));
