@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "lucent/materials/atomic_file.h"
 #include "lucent/acquire/image_io.h"
 #include "lucent/materials/error.h"
 #include "lucent/render/image_compare.h"
@@ -26,6 +27,7 @@ struct CompareArguments {
 };
 
 void run_compare(const CompareArguments& args) {
+  if (!args.difference.empty()) check_output_file(args.difference, "", "--difference");
   const render::ImageRgb image = acquire::read_exr(args.image);
   const render::ImageRgb reference = acquire::read_exr(args.reference);
   const render::ImageDifference d =

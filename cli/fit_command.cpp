@@ -91,9 +91,9 @@ fit::FitOptions to_options(const FitArguments& a) {
 void run(const FitArguments& a) {
   fit::FitOptions options = to_options(a);
   // Where the outputs go is checked before the fit (they are written together at the end).
-  for (const std::string& out : {a.output, a.plot, a.report}) {
-    if (!out.empty()) check_output_folder(out);
-  }
+  check_output_file(a.output, ".json", "-o");
+  if (!a.plot.empty()) check_output_file(a.plot, ".png", "--plot");
+  if (!a.report.empty()) check_output_file(a.report, ".json", "--report");
   std::vector<fit::ProfileData> data;
   for (const std::string& input : a.inputs) {
     data.push_back(fit::load_profile_data(input));
@@ -152,7 +152,7 @@ void run(const FitArguments& a) {
   if (!result.adequate_model.empty())
     std::cout << "  cheapest adequate model for rendering: " << result.adequate_model << '\n';
   for (const std::string& note : result.notes) std::cout << "  note: " << note << '\n';
-  for (const std::string& w : result.warnings) std::cerr << "lucent fit: warning: " << w << '\n';
+  for (const std::string& w : result.warnings) warn("lucent fit: warning: " + w);
   std::cout << "wrote " << a.output << '\n';
 }
 

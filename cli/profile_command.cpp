@@ -26,6 +26,7 @@ struct ProfileArguments {
 
 void run_profile(const ProfileArguments& args) {
   using namespace lucent::materials;
+  if (!args.output.empty() && args.output != "-") check_output_file(args.output, "", "-o");
   const Material material = load_material(args.material);
   const std::string model_name =
       !args.model.empty() ? args.model : (!material.model.empty() ? material.model : "dipole");

@@ -54,8 +54,8 @@ void run_render(RenderArguments& render_args) {
                 "': output must be .png (tone-mapped) or .exr (linear)");
   }
   // Where the outputs go is checked before any work (they are written together at the end).
-  check_output_folder(render_args.output);
-  if (!render_args.stats.empty()) check_output_folder(render_args.stats);
+  check_output_file(render_args.output, "", "-o");
+  if (!render_args.stats.empty()) check_output_file(render_args.stats, ".json", "--stats");
   Scene scene = build_scene(args).scene;
   const auto start = std::chrono::steady_clock::now();
 
@@ -121,12 +121,10 @@ void run_render(RenderArguments& render_args) {
     check_finite_json(doc, render_args.stats);
     write_file_atomically(render_args.stats, doc.dump(2) + "\n");
   }
-  // Said once the image is written (an error stays the one line a failed run prints).
   if (!args.default_rig.empty()) {
     std::string rig;
     for (const auto& light : args.default_rig) rig += " --light " + light;
-    std::fprintf(stderr, "render: no --light or --env: the default rig (key, fill, rim):%s\n",
-                 rig.c_str());
+    warn("render: no --light or --env: the default rig (key, fill, rim):" + rig);
   }
 }
 

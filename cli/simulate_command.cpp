@@ -83,7 +83,7 @@ void run(SimulateArguments& args) {
   o.white_reference = !args.no_white;
   o.dark_frame = !args.no_dark;
   if (!args.exitance_csv.empty()) {
-    check_output_folder(args.exitance_csv);  // before the simulation, not after it
+    check_output_file(args.exitance_csv, ".csv", "--exitance-csv");  // before the simulation
     o.exitance_csv = args.exitance_csv;
   }
 

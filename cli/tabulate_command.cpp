@@ -52,7 +52,7 @@ std::string duration(double seconds) {
 }
 
 void run(TabulateArguments& args) {
-  check_output_folder(args.output);  // before hours of transport, not after
+  check_output_file(args.output, "", "-o");  // before hours of transport, not after
   if (!args.merge.empty()) {
     std::vector<materials::TransportTable> parts;
     for (const std::string& p : args.merge) parts.push_back(materials::read_transport_table(p));

@@ -173,8 +173,13 @@ void write_plot_png(const std::filesystem::path& path, const std::vector<PlotPan
                 cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
   }
   AtomicOutputPath out(path);
-  if (!cv::imwrite(out.temporary().string(), img))
-    throw Error(path.string() + ": cannot write the plot");
+  bool written = false;
+  try {
+    written = cv::imwrite(out.temporary().string(), img);
+  } catch (const cv::Exception&) {
+    written = false;  // e.g. an extension OpenCV has no writer for
+  }
+  if (!written) throw Error(path.string() + ": cannot write the plot (expected a .png file)");
   out.commit();
 }
 

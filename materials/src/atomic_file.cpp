@@ -12,6 +12,7 @@
 #include <atomic>
 #include <cctype>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <mutex>
 #include <regex>
@@ -40,6 +41,7 @@ struct Registry {
   std::vector<fs::path> inputs;       // weakly canonical
   std::vector<Deferred> deferred;     // renames waiting for the transaction
   std::set<fs::path> swept;           // folders already cleaned of dead processes' temporaries
+  std::vector<std::string> warnings;  // for stderr once the transaction commits
   bool transaction = false;
   bool replace_folders = false;
 };
@@ -230,6 +232,18 @@ void check_not_an_input(const fs::path& target) {
   check_not_an_input_locked(target, r);
 }
 
+void warn(const std::string& line) {
+  Registry& r = registry();
+  {
+    std::lock_guard lock(r.mutex);
+    if (r.transaction) {
+      r.warnings.push_back(line);
+      return;
+    }
+  }
+  std::fprintf(stderr, "%s\n", line.c_str());
+}
+
 void check_output_folder(const fs::path& path) {
   const fs::path folder = folder_of(path);
   std::error_code ec;
@@ -237,6 +251,24 @@ void check_output_folder(const fs::path& path) {
     throw Error(path.string() + ": cannot write: the folder " + folder.string() +
                 " does not exist");
   }
+}
+
+void check_output_file(const fs::path& path, const std::string& extension,
+                       const std::string& option) {
+  std::error_code ec;
+  const std::string name = path.filename().string();
+  if (name.empty() || name == "." || name == ".." || fs::is_directory(path, ec)) {
+    throw Error(option + ": '" + path.string() + "' is not a file name (expected a file" +
+                (extension.empty() ? std::string() : " ending in " + extension) + ")");
+  }
+  if (!extension.empty()) {
+    std::string ext = path.extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (ext != extension) {
+      throw Error(option + ": '" + path.string() + "': expected a file ending in " + extension);
+    }
+  }
+  check_output_folder(path);
 }
 
 void set_replace_folders(bool allow) {
@@ -391,6 +423,7 @@ OutputTransaction::OutputTransaction() {
   r.transaction = true;
   r.deferred.clear();
   r.inputs.clear();
+  r.warnings.clear();
 }
 
 OutputTransaction::~OutputTransaction() {
@@ -404,6 +437,7 @@ OutputTransaction::~OutputTransaction() {
   }
   r.deferred.clear();
   r.inputs.clear();
+  r.warnings.clear();  // a failed run says only its error
   r.transaction = false;
 }
 
@@ -457,6 +491,8 @@ void commit_pending_outputs() {
     r.folders.erase(d.temporary);
   }
   r.deferred.clear();
+  for (const std::string& w : r.warnings) std::fprintf(stderr, "%s\n", w.c_str());
+  r.warnings.clear();
 }
 
 void remove_temporaries_on_signals() {

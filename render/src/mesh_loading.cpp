@@ -22,6 +22,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
 #include "lucent/materials/json_file.h"
 #include "lucent/render/mesh_io.h"
@@ -367,8 +368,8 @@ Mesh finish_mesh(Mesh mesh, const std::string& name_or_path, double object_size_
   }
 
   if (const std::size_t bad = count_non_manifold_edges(mesh); bad > 0) {
-    std::cerr << "warning: " << name_or_path << ": " << bad
-              << " non-manifold edges; rendering what is there\n";
+    warn("warning: " + name_or_path + ": " + std::to_string(bad) +
+         " non-manifold edges; rendering what is there");
   }
   return mesh;
 }

@@ -89,6 +89,14 @@ std::vector<BadCase> option_cases() {
       {"fit_model_foo", nullptr, fit + "--model foo", "--model"},
       {"fit_table_missing", nullptr, fit + "--table {dir}/none.lut", "none.lut"},
       {"fit_plot_folder_missing", nullptr, fit + "--plot {dir}/nodir/f.png", "nodir"},
+      {"fit_output_is_folder", nullptr, "fit {world}/acq/profile.json -o {dir}", "-o"},
+      {"fit_output_empty", nullptr, "fit {world}/acq/profile.json -o ''", "-o"},
+      {"fit_plot_not_png", nullptr, fit + "--plot {dir}/f.json", "--plot"},
+      // a warning of the work (dragon:4's non-manifold edges) does not join the error line
+      {"render_dragon_bad_env", nullptr,
+       "render --material marble --mesh dragon:4 --technique reference --size 8x8 "
+       "--samples-pixel 1 --env {dir}/none.exr -o {dir}/r.exr",
+       "none.exr"},
       // acquire
       {"acquire_bins_zero", nullptr, acq + "--bins 0", "--bins"},
       {"acquire_bins_negative", nullptr, acq + "--bins -3", "--bins"},

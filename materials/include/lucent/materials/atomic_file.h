@@ -29,6 +29,11 @@ void check_not_an_input(const std::filesystem::path& target);
 /// would hold `path` exists (commands call it first, so that a typo fails before the work).
 void check_output_folder(const std::filesystem::path& path);
 
+/// check_output_folder, and that `path` names a file (not "", ".", "/" or an existing folder)
+/// ending in `extension` (case-insensitive; empty: any). `option` names it in the error.
+void check_output_file(const std::filesystem::path& path, const std::string& extension,
+                       const std::string& option);
+
 /// Writes `content` to `path` atomically. Text (binary = false) is checked first: a "nan" or
 /// "inf" number token is refused (lucent never writes one). Throws lucent::Error naming the path.
 void write_file_atomically(const std::filesystem::path& path, std::string_view content,
@@ -95,6 +100,11 @@ class OutputTransaction {
   /// replaced are restored from their backups before the error is thrown.
   void commit();
 };
+
+/// A warning for stderr (one line, without the trailing newline). While a transaction is open it
+/// waits for the commit, so that a run that fails prints its one error line and nothing else;
+/// without one it is printed at once.
+void warn(const std::string& line);
 
 /// Commits what the open transaction holds so far (the viewer's screenshots appear at once);
 /// OutputTransaction::commit() calls it. Without a transaction there is nothing pending.
