@@ -112,6 +112,25 @@ class BodyReader {
     return 0;
   }
 
+  // A list property's length, checked against what is left (each item takes at least a byte).
+  std::uint64_t list_length(const Property& p, const std::string& where) {
+    const double n = read(p.count_type, where);
+    if (!(n >= 0) || n > double(left())) {
+      throw Error(source_ + ": " + where + ": list length " + std::to_string(n) +
+                  " is out of range");
+    }
+    return static_cast<std::uint64_t>(n);
+  }
+
+  // Reads past one property's value (a scalar, or a whole list).
+  void skip(const Property& p, const std::string& where) {
+    if (!p.list) {
+      read(p.type, where);
+      return;
+    }
+    for (std::uint64_t j = 0, n = list_length(p, where); j < n; ++j) read(p.type, where);
+  }
+
   // The fewest bytes one item of `e` can take: checks a header's count before anything is
   // allocated for it.
   std::size_t min_item_bytes(const Element& e) const {
@@ -296,14 +315,10 @@ Mesh parse_ply(std::string_view bytes, const std::string& source) {
         const std::string where = "vertex " + std::to_string(k);
         for (std::size_t i = 0; i < e.properties.size(); ++i) {
           const Property& p = e.properties[i];
-          if (p.list) {
-            const double n = body.read(p.count_type, where);
-            if (!(n >= 0) || n > double(body.left()))
-              throw Error(source + ": " + where + ": list length " + std::to_string(n) + " is out of range");
-            for (std::uint64_t j = 0; j < static_cast<std::uint64_t>(n); ++j) body.read(p.type, where);
-          } else {
+          if (p.list)
+            body.skip(p, where);
+          else
             values[i] = body.read(p.type, where);
-          }
         }
         const Vec3f position(static_cast<float>(values[x]), static_cast<float>(values[y]),
                              static_cast<float>(values[z]));
@@ -327,20 +342,15 @@ Mesh parse_ply(std::string_view bytes, const std::string& source) {
         const std::string where = "face " + std::to_string(k);
         for (std::size_t i = 0; i < e.properties.size(); ++i) {
           const Property& p = e.properties[i];
-          if (!p.list) {
-            body.read(p.type, where);
+          if (int(i) != indices) {
+            body.skip(p, where);
             continue;
           }
-          const double n = body.read(p.count_type, where);
-          if (!(n >= 0) || n > double(body.left()))
-            throw Error(source + ": " + where + ": list length is out of range");
           polygon.clear();
-          for (std::uint64_t j = 0; j < static_cast<std::uint64_t>(n); ++j) {
-            const double v = body.read(p.type, where);
-            if (int(i) == indices)
-              polygon.push_back(vertex_index(v, mesh.positions.size(), source, where));
+          for (std::uint64_t j = 0, n = body.list_length(p, where); j < n; ++j) {
+            polygon.push_back(vertex_index(body.read(p.type, where), mesh.positions.size(), source,
+                                           where));
           }
-          if (int(i) != indices) continue;
           for (std::size_t j = 2; j < polygon.size(); ++j)  // a fan; points and lines add nothing
             mesh.triangles.push_back({polygon[0], polygon[j - 1], polygon[j]});
         }
@@ -348,16 +358,7 @@ Mesh parse_ply(std::string_view bytes, const std::string& source) {
     } else {
       for (std::uint64_t k = 0; k < e.count; ++k) {
         const std::string where = e.name + " " + std::to_string(k);
-        for (const Property& p : e.properties) {
-          if (!p.list) {
-            body.read(p.type, where);
-            continue;
-          }
-          const double n = body.read(p.count_type, where);
-          if (!(n >= 0) || n > double(body.left()))
-            throw Error(source + ": " + where + ": list length is out of range");
-          for (std::uint64_t j = 0; j < static_cast<std::uint64_t>(n); ++j) body.read(p.type, where);
-        }
+        for (const Property& p : e.properties) body.skip(p, where);
       }
     }
   }
