@@ -207,7 +207,8 @@ std::vector<BadCase> profile_csv_cases() {
       {"csv_no_ior", csv("r_mm,R\n1,0.1\n2,0.05\n"), args, "--ior"},
       {"csv_dev_zero", nullptr, "fit /dev/zero -o {dir}/m.json", "/dev/zero"},
       {"csv_overwrites_input",
-       [](const fs::path& d) { write_file(d / "p.csv", read_bytes(world() / "radial.csv")); }, "fit {dir}/p.csv -o {dir}/p.csv", "is an input"},
+       [](const fs::path& d) { write_file(d / "p.csv", read_bytes(world() / "radial.csv")); },
+       "fit {dir}/p.csv -o {dir}/p.csv", "expected a file ending in .json"},
   };
 }
 
@@ -237,6 +238,8 @@ std::vector<BadCase> configs_cases() {
       {"configs_binary", csv(std::string("\0\1\2\3", 4)), args, "k.csv"},
       {"configs_dev_zero", nullptr,
        "profile --material marble --configs /dev/zero -o {dir}/out.csv", "/dev/zero"},
+      {"configs_overwrites_input", csv(header + row),
+       "profile --material marble --configs {dir}/k.csv -o {dir}/k.csv", "is an input"},
       {"configs_output_folder_missing", csv(header + row),
        "profile --material marble --configs {dir}/k.csv -o {dir}/nodir/out.csv", "nodir"},
   };
