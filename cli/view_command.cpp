@@ -7,6 +7,7 @@
 #include <string>
 
 #include "commands.h"
+#include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
 #include "scene_options.h"
 #if LUCENT_HAS_VIEWER
@@ -52,6 +53,8 @@ void run_view(ViewArguments& args) {
     std::printf("view: no --light or --env: the default rig (key, fill, rim):%s\n", rig.c_str());
     std::fflush(stdout);
   }
+  // The window may stay open for hours: say the scene's warnings now, not when it closes.
+  commit_pending_outputs();
   const int status = render::run_viewer(options);
   if (status != 0) std::exit(status);
 #else
