@@ -1,6 +1,11 @@
 // Bad-input tables for lucent's images and meshes: exposure brackets (PNG), OpenEXR and Radiance
 // images (captures, comparisons, environment maps) and PLY/OBJ meshes. See bad_input.h.
 
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfOutputFile.h>
+
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -77,6 +82,31 @@ std::function<void(const fs::path&)> bytes_at(std::string bytes) {
   return [=](const fs::path& p) { write_file(p, bytes); };
 }
 
+// The world's capture as one HDR image (no brackets), the image made by `make` in the case folder.
+std::function<void(const fs::path&)> capture_hdr(std::function<void(const fs::path&)> make) {
+  return [=](const fs::path& d) {
+    if (make) make(d / "h.exr");
+    Json c = read_json(world() / "capture_abs.json");
+    c.erase("images");
+    c.erase("dark");
+    c.erase("white_reference");
+    c["hdr"] = (d / "h.exr").string();
+    write_file(d / "c.json", c.dump(2));
+  };
+}
+
+// An EXR whose only channel is Z: neither RGB nor Y.
+void write_z_only_exr(const fs::path& path) {
+  Imf::Header header(4, 4);
+  header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
+  std::vector<float> z(16, 1.0f);
+  Imf::OutputFile file(path.c_str(), header);
+  Imf::FrameBuffer frame;
+  frame.insert("Z", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(z.data()), 4, 16));
+  file.setFrameBuffer(frame);
+  file.writePixels(4);
+}
+
 // ---- brackets (PNG through lucent acquire) ------------------------------------------------------
 std::vector<BadCase> bracket_cases() {
   const std::string args = "acquire {dir}/c.json -o {dir}/out";
@@ -121,17 +151,7 @@ std::vector<BadCase> bracket_cases() {
        "img.png"},
       {"bracket_jpeg_bytes_as_png", capture_with("image", bytes_at("\xff\xd8\xff\xe0garbage")),
        args, "img.png"},
-      {"capture_hdr_text",
-       [](const fs::path& d) {
-         write_file(d / "h.exr", "not an exr");
-         Json c = read_json(world() / "capture_abs.json");
-         c.erase("images");
-         c.erase("dark");
-         c.erase("white_reference");
-         c["hdr"] = (d / "h.exr").string();
-         write_file(d / "c.json", c.dump(2));
-       },
-       args, "h.exr"},
+      {"capture_hdr_text", capture_hdr(bytes_at("not an exr")), args, "h.exr"},
   };
 }
 
@@ -173,6 +193,34 @@ std::vector<BadCase> image_cases() {
        "render --material marble --mesh sphere --technique reference --size 8x8 "
        "--samples-pixel 1 --env {dir}/e.exr -o {dir}/e.exr",
        "is an input"},
+      {"exr_reference_missing", [](const fs::path& d) { fs::copy_file(world() / "env.exr", d / "a.exr"); },
+       "compare {dir}/a.exr {dir}/none.exr", "none.exr"},
+      {"exr_reference_text", bytes_file("r.exr", "text"), "compare {world}/env.exr {dir}/r.exr",
+       "r.exr"},
+      {"exr_no_rgb_channels", [](const fs::path& d) { write_z_only_exr(d / "a.exr"); }, cmp,
+       "neither R, G, B nor Y"},
+      {"exr_dev_zero", nullptr, "compare /dev/zero {world}/env.exr", "/dev/zero"},
+      {"exr_hdr_given_to_compare", [](const fs::path& d) { fs::copy_file(world() / "env.hdr", d / "a.exr"); },
+       cmp, "a.exr"},
+      {"capture_hdr_missing", capture_hdr(nullptr), "acquire {dir}/c.json -o {dir}/out", "h.exr"},
+      {"capture_hdr_all_nan",
+       capture_hdr([](const fs::path& p) {
+         write_raw_exr(p, acquire::ImageRgb(32, 32, std::nanf("")));
+       }),
+       "acquire {dir}/c.json -o {dir}/out", "no finite pixels"},
+      {"capture_hdr_truncated",
+       capture_hdr([](const fs::path& p) {
+         const std::string b = read_bytes(world() / "env.exr");
+         write_file(p, b.substr(0, b.size() - 20));
+       }),
+       "acquire {dir}/c.json -o {dir}/out", "h.exr"},
+      {"env_light_count_huge", nullptr, env + "{world}/env.exr:5000", "--env"},
+      {"env_directory", [](const fs::path& d) { fs::create_directory(d / "e.exr"); },
+       env + "{dir}/e.exr", "e.exr"},
+      {"env_dev_zero", nullptr, env + "/dev/zero", "/dev/zero"},
+      {"env_hdr_header_only", bytes_file("e.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8 +X 16\n"),
+       env + "{dir}/e.hdr", "e.hdr"},
+      {"env_exr_text", bytes_file("e.exr", "not an exr"), env + "{dir}/e.exr", "e.exr"},
       {"compare_difference_overwrites_input",
        [](const fs::path& d) { fs::copy_file(world() / "env.exr", d / "a.exr"); },
        "compare {dir}/a.exr {world}/env.exr --difference {dir}/a.exr", "is an input"},
