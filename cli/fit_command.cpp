@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "commands.h"
+#include "oblique_table.h"
 #include "validators.h"
 #include "lucent/materials/json_file.h"
 #include "lucent/materials/transport_table.h"
@@ -28,7 +29,8 @@ struct FitArguments {
   CLI::Option* ior_option = nullptr;
   double ior = 0;
   double g = 0;
-  std::string table;
+  std::string table, oblique_table;
+  std::uint64_t oblique_photons = 1'000'000;
   bool fit_ior = false, relative = false, json = false, allow_unconverged = false;
 };
 
@@ -107,6 +109,9 @@ void run(const FitArguments& a) {
     table = materials::read_transport_table(a.table);
     options.table = &table;
   }
+  const std::optional<materials::TransportTable> oblique =
+      oblique_table_for(data, options, a.oblique_table, a.oblique_photons, a.json);
+  if (oblique) options.oblique_table = &*oblique;
   const fit::FitResult result = fit::fit_profiles(data, options);
   std::string name = a.name;
   if (name.empty()) name = std::filesystem::path(a.output).stem().string();
@@ -181,6 +186,15 @@ void register_fit_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--table", args->table,
                   "transport table for the tabulated model (default: the shipped one)");
+  cmd->add_option("--oblique-table", args->oblique_table,
+                  "oblique transport table (lucent tabulate --incidence-deg) for 2D captures at "
+                  "oblique incidence (default: the shipped one when it holds the capture's eta, "
+                  "g and incidence, else one built now and kept in ~/.cache/lucent)");
+  cmd->add_option("--oblique-photons", args->oblique_photons,
+                  "photons of an oblique table built for this fit (about 50 s per million on "
+                  "2 cores)")
+      ->check(CLI::Range(std::uint64_t(10'000), std::uint64_t(1'000'000'000)))
+      ->capture_default_str();
   args->exclude_option = cmd->add_option(
       "--exclude-radius-mm", args->exclude_radius_mm,
       "leave out samples closer to the entry point than this, mm, in every channel (default: "

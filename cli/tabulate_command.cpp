@@ -20,6 +20,8 @@ struct TabulateArguments {
   std::string output;
   std::string eta = "1.0,1.1,1.2,1.3,1.4,1.5,1.6";
   std::string g = "0";
+  std::string incidence = "0";
+  int phi_bins = 0;  // 0: 1 at normal incidence, the oblique grid's otherwise
   std::string shard;
   std::vector<std::string> merge;
   bool quiet = false;
@@ -66,6 +68,13 @@ void run(TabulateArguments& args) {
   acquire::TabulateOptions& o = args.options;
   o.eta = parse_list(args.eta, "--eta");
   o.g = parse_list(args.g, "--g");
+  o.incidence_deg = parse_list(args.incidence, "--incidence-deg");
+  const bool oblique = o.incidence_deg.size() > 1 || o.incidence_deg.front() != 0;
+  if (oblique) {
+    // An oblique table: the oblique grid (coarser in rho, azimuth wedges).
+    o.grid = materials::default_oblique_grid();
+  }
+  if (args.phi_bins > 0) o.grid.phi_bins = args.phi_bins;
   if (!args.shard.empty()) {
     const auto slash = args.shard.find('/');
     try {
@@ -97,9 +106,10 @@ void run(TabulateArguments& args) {
   if (!args.quiet) {
     if (last != start) std::cerr << "\r" << std::string(60, ' ') << "\r";
     std::cout << "wrote " << (table.partial ? "shard " + table.shard + " " : std::string())
-              << args.output << ": " << table.slice_axes.size() << " slices (eta x g), "
-              << table.grid.u.size() << " albedos x " << table.grid.rho_bins() << " radii, "
-              << std::uint64_t(table.slice_axes.front()[2]) << " photons per slice, in "
+              << args.output << ": " << table.slice_axes.size() << " slices (eta x g"
+              << (oblique ? " x incidence" : "") << "), " << table.grid.u.size() << " albedos x "
+              << (oblique ? std::to_string(table.grid.phi_bins) + " azimuths x " : std::string())
+              << table.grid.rho_bins() << " radii, " << std::uint64_t(table.slice_axes.front()[2]) << " photons per slice, in "
               << duration(seconds) << '\n';
   }
 }
@@ -121,7 +131,15 @@ void register_tabulate_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--g", args->g, "Henyey-Greenstein g values, increasing, in [0, 0.95]")
       ->capture_default_str();
-  cmd->add_option("--photons", o.photons, "photons per (eta, g) slice")->capture_default_str();
+  cmd->add_option("--incidence-deg", args->incidence,
+                  "beam angles from the normal (degrees, increasing, in [0, 85]); any > 0 builds "
+                  "an oblique table (2D profile in rho and azimuth, for 2D captures at that "
+                  "incidence: lucent fit --oblique-table)")
+      ->capture_default_str();
+  cmd->add_option("--phi-bins", args->phi_bins,
+                  "azimuth wedges over [0, pi] (default: 1, or 12 for an oblique table)")
+      ->check(CLI::Range(1, 360));
+  cmd->add_option("--photons", o.photons, "photons per slice")->capture_default_str();
   cmd->add_option("--seed", o.seed, "random seed (same table for any --threads or sharding)")
       ->check(seed_value())
       ->capture_default_str();

@@ -17,6 +17,11 @@
 // growing c; once c L passes 40 (e^-40 = 4e-18 of the weight) the rest are skipped, so a long
 // path touches only the high-albedo nodes it matters for.
 //
+// Oblique incidence (a slice's incidence_deg > 0): the photon starts along the refracted beam,
+// sin(theta_t) = sin(theta) / eta, travelling toward +x, and every tally goes to the wedge of
+// phi = atan2(|y|, x) as well as the radius bin. The white scaling is unchanged: the start
+// direction does not depend on the albedo, and scaling lengths keeps phi.
+//
 // Standard errors come from `groups` independent photon groups per slice (the spread of the group
 // means), which is also what makes the table shardable: a shard computes some (slice, group)
 // units, a merge puts them together, and the finishing step is the same for both.
@@ -48,6 +53,8 @@ constexpr double kMaxOpticalWeightExponent = 40;  // e^-40: below anything a tab
 
 struct SliceConstants {
   double eta = 1, g = 0;
+  double incidence = 0;         // degrees, outside
+  double sin_t = 0, cos_t = 1;  // the refracted beam's direction: (sin_t, 0, -cos_t)
   double sigma_s = 1;     // white medium, units of sigma_s' = 1
   double eta_out = 1;     // 1 / eta
   double nee_factor = 1;  // T(normal, going out) / eta^2
@@ -66,9 +73,11 @@ struct AlbedoNode {
   double shift = 0;  // bin index offset: -log10(a) * per_decade - log10(rho_min) * per_decade
 };
 
-std::uint64_t slice_seed(std::uint64_t seed, double eta, double g, int group) {
-  const std::uint64_t h = detail::mix64(std::bit_cast<std::uint64_t>(eta)) ^
-                          detail::mix64(std::bit_cast<std::uint64_t>(g) + 0x9e37);
+std::uint64_t slice_seed(std::uint64_t seed, double eta, double g, double incidence, int group) {
+  std::uint64_t h = detail::mix64(std::bit_cast<std::uint64_t>(eta)) ^
+                    detail::mix64(std::bit_cast<std::uint64_t>(g) + 0x9e37);
+  // Normal incidence keeps the seeds (and so the tables) of the radial builds.
+  if (incidence != 0) h ^= detail::mix64(std::bit_cast<std::uint64_t>(incidence) + 0x51ed);
   return detail::stream_seed(seed ^ h, 7, static_cast<std::uint64_t>(group));
 }
 
@@ -79,8 +88,9 @@ struct Walk {
   const SliceConstants* slice = nullptr;
 };
 
-// Traces one photon from the entry point straight down: calls escape(rho, path, weight) when it
-// leaves through the surface and event(rho, path, depth, weight, cos_up) at each collision before
+// Traces one photon from the entry point along the refracted beam: calls escape(x, y, path,
+// weight) when it leaves through the surface and event(x, y, path, depth, weight, cos_up) at each
+// collision before
 // it scatters (weight before the implicit capture). Stops at max_path, or when Russian roulette
 // (below a weight of 1e-4, survival 1/10) ends an absorbing walk.
 template <typename Escape, typename Event>
@@ -89,7 +99,7 @@ void walk_photon(const Walk& m, Xoshiro256StarStar& rng, double max_path, Escape
   const detail::ExponentialZiggurat& exponential = detail::exponential_ziggurat();
   const SliceConstants& s = *m.slice;
   const double inv_sigma_t = 1.0 / m.sigma_t;
-  double x = 0, y = 0, z = 0, ux = 0, uy = 0, uz = -1, w = 1, path = 0;
+  double x = 0, y = 0, z = 0, ux = s.sin_t, uy = 0, uz = -s.cos_t, w = 1, path = 0;
   for (;;) {
     double step = exponential.sample(rng) * inv_sigma_t;
     while (uz > 0 && z + uz * step >= 0) {  // reaches the surface before the next collision
@@ -102,7 +112,7 @@ void walk_photon(const Walk& m, Xoshiro256StarStar& rng, double max_path, Escape
       step -= d;
       const double R = materials::fresnel_reflectance(uz, s.eta_out);
       if (R < 1 && !(rng.uniform() < R)) {
-        escape(std::sqrt(x * x + y * y), path, w);
+        escape(x, y, path, w);
         return;
       }
       uz = -uz;
@@ -112,7 +122,7 @@ void walk_photon(const Walk& m, Xoshiro256StarStar& rng, double max_path, Escape
     z += uz * step;
     path += step;
     if (path > max_path) return;
-    event(std::sqrt(x * x + y * y), path, -z, w, uz);
+    event(x, y, path, -z, w, uz);
     if (m.albedo < 1) {
       w *= m.albedo;
       if (w < 1e-4) {
@@ -131,20 +141,30 @@ void trace_group(const SliceConstants& s, const std::vector<AlbedoNode>& nodes,
                  std::uint64_t photons, Xoshiro256StarStar& rng,
                  materials::TransportTableGroup& out, std::atomic<std::uint64_t>& done) {
   const int J = grid.rho_bins();
+  const int P = grid.phi_bins;
   const std::size_t K = nodes.size();
   const double per_decade = grid.rho_per_decade;
   const double log_rho_min = std::log10(grid.rho_min) * per_decade;
   std::vector<double>& exitance = out.value[0];
   std::vector<double>& radiance = out.value[1];
-  exitance.assign(K * std::size_t(J), 0.0);
-  radiance.assign(K * std::size_t(J), 0.0);
+  exitance.assign(grid.entries(), 0.0);
+  radiance.assign(grid.entries(), 0.0);
+  // The wedge of a point, and the offset of its row within a u node's block of P rows.
+  const auto wedge = [P](double x, double y) {
+    if (P == 1) return std::size_t(0);
+    const int p = int(std::atan2(std::abs(y), x) * (P / std::numbers::pi));
+    return std::size_t(std::clamp(p, 0, P - 1));
+  };
   out.total.assign(K, 0.0);
   std::size_t white_nodes = 0;
   while (white_nodes < K && nodes[white_nodes].white) ++white_nodes;
 
   // White run: each event counts for every white node k at radius rho_w / a_k with e^(-c_k L).
-  const auto score = [&](std::vector<double>* tally, double rho_w, double path, double weight) {
+  const auto score = [&](std::vector<double>* tally, double x, double y, double path,
+                         double weight) {
+    const double rho_w = std::sqrt(x * x + y * y);
     const double lr = rho_w > 0 ? std::log10(rho_w) * per_decade : -1e300;
+    const std::size_t p = wedge(x, y);
     for (std::size_t k = 0; k < white_nodes; ++k) {
       const double exponent = nodes[k].c * path;
       if (exponent > kMaxOpticalWeightExponent) break;
@@ -155,22 +175,22 @@ void trace_group(const SliceConstants& s, const std::vector<AlbedoNode>& nodes,
       }
       const double fj = lr + nodes[k].shift;
       if (fj < 0 || fj >= J) continue;
-      (*tally)[k * std::size_t(J) + std::size_t(fj)] += w;
+      (*tally)[(k * std::size_t(P) + p) * std::size_t(J) + std::size_t(fj)] += w;
     }
   };
   const Walk white{s.sigma_s, 1.0, &s};
   for (std::uint64_t n = 0; n < photons; ++n) {
     walk_photon(
         white, rng, max_path,
-        [&](double rho, double path, double) {
-          score(&exitance, rho, path, 1.0);
-          score(nullptr, rho, path, 1.0);
+        [&](double x, double y, double path, double) {
+          score(&exitance, x, y, path, 1.0);
+          score(nullptr, x, y, path, 1.0);
         },
-        [&](double rho, double path, double depth, double, double cos_up) {
+        [&](double x, double y, double path, double depth, double, double cos_up) {
           // Next-event estimate of the radiance leaving along the normal.
           if (s.sigma_s * depth < kMaxOpticalWeightExponent) {
             const double v = s.nee_factor * s.hg.pdf(cos_up) * std::exp(-s.sigma_s * depth);
-            score(&radiance, rho, path + depth, v);
+            score(&radiance, x, y, path + depth, v);
           }
         });
     if ((n & 1023) == 1023) done.fetch_add(1024, std::memory_order_relaxed);
@@ -182,37 +202,41 @@ void trace_group(const SliceConstants& s, const std::vector<AlbedoNode>& nodes,
     const double a = nodes[k].alpha_prime;
     const double sigma_s = a / (1 - s.g);
     const Walk direct{(1 - a) + sigma_s, sigma_s / ((1 - a) + sigma_s), &s};
-    const auto bin = [&](double rho) {
+    // The entry of (x, y) in node k's rows, or -1 outside the radii.
+    const auto bin = [&](double x, double y) -> long {
+      const double rho = std::sqrt(x * x + y * y);
       const double fj = (rho > 0 ? std::log10(rho) * per_decade : -1e300) - log_rho_min;
-      return fj >= 0 && fj < J ? int(fj) : -1;
+      if (!(fj >= 0 && fj < J)) return -1;
+      return long((k * std::size_t(P) + wedge(x, y)) * std::size_t(J) + std::size_t(fj));
     };
     for (std::uint64_t n = 0; n < photons; ++n) {
       walk_photon(
           direct, rng, max_path,
-          [&](double rho, double, double w) {
+          [&](double x, double y, double, double w) {
             out.total[k] += w;
-            if (const int j = bin(rho); j >= 0) exitance[k * std::size_t(J) + std::size_t(j)] += w;
+            if (const long e = bin(x, y); e >= 0) exitance[std::size_t(e)] += w;
           },
-          [&](double rho, double, double depth, double w, double cos_up) {
+          [&](double x, double y, double, double depth, double w, double cos_up) {
             const double tau = direct.sigma_t * depth;
             if (tau >= kMaxOpticalWeightExponent) return;
-            if (const int j = bin(rho); j >= 0)
-              radiance[k * std::size_t(J) + std::size_t(j)] +=
+            if (const long e = bin(x, y); e >= 0)
+              radiance[std::size_t(e)] +=
                   w * direct.albedo * s.nee_factor * s.hg.pdf(cos_up) * std::exp(-tau);
           });
     }
   }
 
-  // Means per photon, per unit area of the real medium's annuli; pi L for the radiance.
-  for (std::size_t k = 0; k < K; ++k) {
+  // Means per photon, per unit area of the real medium's annuli (or wedges of them, both sides
+  // of y = 0: 1 / P of the annulus); pi L for the radiance.
+  for (std::size_t row = 0; row < grid.rows(); ++row) {
     for (int j = 0; j < J; ++j) {
       const double r0 = grid.rho_edge(j), r1 = grid.rho_edge(j + 1);
-      const double area = std::numbers::pi * (r1 * r1 - r0 * r0);
-      exitance[k * std::size_t(J) + std::size_t(j)] /= double(photons) * area;
-      radiance[k * std::size_t(J) + std::size_t(j)] *= std::numbers::pi / (double(photons) * area);
+      const double area = std::numbers::pi * (r1 * r1 - r0 * r0) / P;
+      exitance[row * std::size_t(J) + std::size_t(j)] /= double(photons) * area;
+      radiance[row * std::size_t(J) + std::size_t(j)] *= std::numbers::pi / (double(photons) * area);
     }
-    out.total[k] /= double(photons);
   }
+  for (std::size_t k = 0; k < K; ++k) out.total[k] /= double(photons);
 }
 
 }  // namespace
@@ -223,6 +247,15 @@ void validate_tabulate_options(const TabulateOptions& o) {
   for (double e : o.eta)
     if (!(e >= 1.0 && e <= 2.5)) bad("--eta: each relative index must be in [1, 2.5]");
   if (o.g.empty()) bad("--g: at least one anisotropy is needed");
+  if (o.incidence_deg.empty()) bad("--incidence-deg: at least one angle is needed");
+  for (double a : o.incidence_deg)
+    if (!(a >= 0 && a <= 85)) bad("--incidence-deg: each angle must be in [0, 85] degrees");
+  for (std::size_t i = 1; i < o.incidence_deg.size(); ++i)
+    if (!(o.incidence_deg[i] > o.incidence_deg[i - 1]))
+      bad("--incidence-deg: the angles must be strictly increasing");
+  if (o.grid.phi_bins < 1 || o.grid.phi_bins > 360) bad("--phi-bins: expected 1..360");
+  if (o.grid.phi_bins == 1 && (o.incidence_deg.size() > 1 || o.incidence_deg[0] != 0))
+    bad("--phi-bins: an oblique table needs azimuth wedges (e.g. 12)");
   for (double g : o.g)
     if (!(g >= 0.0 && g <= 0.95)) bad("--g: each Henyey-Greenstein g must be in [0, 0.95]");
   for (std::size_t i = 1; i < o.eta.size(); ++i)
@@ -256,18 +289,23 @@ materials::TransportTable tabulate_transport(const TabulateOptions& o,
   const std::uint64_t per_group = (o.photons + std::uint64_t(o.groups) - 1) / std::uint64_t(o.groups);
 
   std::vector<SliceConstants> slices;
+  for (double incidence : o.incidence_deg) {
   for (double g : o.g) {
     for (double eta : o.eta) {
       SliceConstants s;
       s.eta = eta;
       s.g = g;
+      s.incidence = incidence;
+      s.sin_t = std::sin(incidence * std::numbers::pi / 180) / eta;
+      s.cos_t = std::sqrt(1 - s.sin_t * s.sin_t);
       s.sigma_s = 1.0 / (1.0 - g);
       s.eta_out = 1.0 / eta;
       s.nee_factor = materials::fresnel_transmittance(1.0, s.eta_out) / (eta * eta);
       s.hg = HenyeyGreenstein(g);
       slices.push_back(s);
-      table.slice_axes.push_back({eta, g, double(per_group * std::uint64_t(o.groups))});
+      table.slice_axes.push_back({eta, g, double(per_group * std::uint64_t(o.groups)), incidence});
     }
+  }
   }
   std::vector<AlbedoNode> nodes;
   for (double u : o.grid.u) {
@@ -299,7 +337,8 @@ materials::TransportTable tabulate_transport(const TabulateOptions& o,
       if (i >= units.size() || failed) return;
       try {
         const auto [s, g] = units[i];
-        Xoshiro256StarStar rng(slice_seed(o.seed, slices[s].eta, slices[s].g, g));
+        Xoshiro256StarStar rng(
+            slice_seed(o.seed, slices[s].eta, slices[s].g, slices[s].incidence, g));
         results[i].slice = s;
         results[i].group = g;
         trace_group(slices[s], nodes, o.grid, o.max_path, per_group, rng, results[i], done);

@@ -1,4 +1,5 @@
 #include "lucent/fit/fit.h"
+#include "lucent/materials/oblique.h"
 
 #include <ceres/ceres.h>
 #include <glog/logging.h>
@@ -135,6 +136,24 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
     table_problem =
         "the tabulated model needs a camera along the normal, and oblique incidence as 2D samples";
   }
+  // Oblique 2D data at one incidence, eta held: the oblique table's slice, when it has one.
+  std::string oblique_source;
+  if (oblique && fixed && !options.fit_ior) {
+    std::optional<double> incidence;
+    bool one_incidence = true;
+    for (const ProfileData& d : data) {
+      if (!(d.samples_2d.has_value() && d.incidence_polar_deg > 0)) continue;
+      if (incidence && std::abs(*incidence - d.incidence_polar_deg) > 1e-6) one_incidence = false;
+      incidence = d.incidence_polar_deg;
+    }
+    if (incidence && one_incidence && options.oblique_table &&
+        materials::ObliqueProfile::has_slice(*options.oblique_table, eta0, options.g, *incidence)) {
+      auto slice = std::make_shared<const materials::ObliqueProfile>(*options.oblique_table, eta0,
+                                                                     options.g, *incidence);
+      fixed = std::make_shared<const materials::TabulatedProfile>(fixed->with_oblique(slice));
+      oblique_source = slice->to_string();
+    }
+  }
   const bool tab_ok = full && table_problem.empty();
   if (options.model == FitModel::kTabulated && !tab_ok)
     throw Error("--model tabulated: " + table_problem);
@@ -257,7 +276,12 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
 
   if (tab_ok) {
     result.chosen = result.candidates.front();
-    if (options.model == FitModel::kAuto && oblique) {
+    if (options.model == FitModel::kAuto && oblique && !oblique_source.empty()) {
+      result.reason =
+          "tabulated: oblique incidence, exact to radiative transfer (lucent's Monte Carlo 2D "
+          "transport table at the capture's incidence, " + oblique_source +
+          "); the cheaper models are judged against it";
+    } else if (options.model == FitModel::kAuto && oblique) {
       result.reason =
           "tabulated: oblique incidence, the directional dipole corrected by lucent's Monte Carlo "
           "transport table (g = " + std::to_string(options.g).substr(0, 4) +

@@ -33,6 +33,7 @@ json model_fit_json(const ModelFit& f) {
                         {"sd_sys_sigma_a", finite_or_null(c.sd_sys_sigma_a)},
                         {"sd_sys_sigma_s_reduced", finite_or_null(c.sd_sys_sigma_s_reduced)},
                         {"reduced_chi2", finite_or_null(c.reduced_chi2)},
+                        {"design_effect", finite_or_null(c.design_effect)},
                         {"exclude_radius_mm", finite_or_null(c.exclude_radius_mm)},
                         {"range_end_mm", finite_or_null(c.range_end_mm)},
                         {"range_diffusion_lengths", finite_or_null(c.range_diffusion_lengths)},

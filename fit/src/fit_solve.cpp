@@ -8,6 +8,8 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <map>
+#include <tuple>
 #include <chrono>
 #include <cmath>
 #include <deque>
@@ -57,6 +59,13 @@ struct Observations {
   std::vector<double> log_value;   // log of the measurement
   std::vector<double> inv_rel_se;  // value / standard error: weights the log-ratio
   std::vector<double> data_rel_se;  // the data's own relative standard error (before the table's)
+  // Single pixels (2D samples) are fitted in linear form, (model - value) / se: at their per-pixel
+  // noise (10-40% in a faint tail) a log-ratio is biased (E log v < log E v) and a noise-floor cut
+  // selects upward fluctuations; every pixel is kept, negative ones too. Then `value` and
+  // `inv_se` are used, log_value holds log(max(value, se)) (sizes and plots only).
+  bool linear = false;
+  std::vector<double> value, inv_se, data_se;
+  int capture = 0;  // index of the profile these come from
 };
 
 // Residuals (log model - log data) * value / se: the log-ratio in units of the relative standard
@@ -86,13 +95,20 @@ struct ProfileResiduals {
     // read at every sample.
     std::optional<materials::TabulatedModel<T>> tab;
     std::optional<materials::DirectionalDipole<T>> dd;  // oblique 2D data: the corrected ddipole
-    if (model == FitModel::kTabulated) tab.emplace(*table, medium);
+    std::optional<materials::ObliqueModel<T>> ob;  // or the oblique table, where there is one
     const bool oblique = !obs->radial && obs->geometry.cos_incidence < 0.9999;
+    if (model == FitModel::kTabulated) {
+      if (oblique && table->oblique())
+        ob.emplace(*table->oblique(), medium);
+      else
+        tab.emplace(*table, medium);
+    }
     if (tab && oblique) dd.emplace(medium);
     const materials::TableQuantity q = detail::table_quantity(obs->geometry);
     for (std::size_t i = 0; i < n; ++i) {
       const T v =
-          tab ? (obs->radial  ? detail::tabulated_annulus(*tab, q, obs->r[i], obs->r0[i], obs->r1[i], gl)
+          ob ? detail::oblique_pixel(*ob, q, obs->geometry, obs->x[i], obs->y[i], obs->pixel, gl)
+          : tab ? (obs->radial  ? detail::tabulated_annulus(*tab, q, obs->r[i], obs->r0[i], obs->r1[i], gl)
                  : oblique ? detail::corrected_ddipole_pixel(*tab, *dd, q, obs->geometry, obs->x[i],
                                                              obs->y[i], obs->pixel, gl)
                            : detail::tabulated_pixel(*tab, q, obs->x[i], obs->y[i], obs->pixel, gl))
@@ -105,7 +121,10 @@ struct ProfileResiduals {
         const double r = obs->radial ? obs->r[i] : std::hypot(obs->x[i], obs->y[i]);
         scaled *= perturbation.factor(T(r) * (medium.sigma_a + medium.sigma_s));
       }
-      residual[i] = (log_front + log(scaled + T(1e-300)) - obs->log_value[i]) * obs->inv_rel_se[i];
+      if (obs->linear)
+        residual[i] = (exp(log_front) * scaled - obs->value[i]) * obs->inv_se[i];
+      else
+        residual[i] = (log_front + log(scaled + T(1e-300)) - obs->log_value[i]) * obs->inv_rel_se[i];
     }
     return true;
   }
@@ -265,10 +284,12 @@ Observations observations_for(const ProfileData& d, int c, double exclude_mm, bo
     const Samples2d& s = *d.samples_2d;
     o.radial = false;
     o.pixel = s.pixel_mm;
+    o.linear = true;
     std::vector<std::size_t> idx;
     for (std::size_t i = 0; i < s.size(); ++i) {
-      if (std::hypot(s.x_mm[i], s.y_mm[i]) >= exclude_mm &&
-          keep(s.value[c][i], s.standard_error[c][i])) {
+      const double v = s.value[c][i], se = s.standard_error[c][i];
+      if (std::hypot(s.x_mm[i], s.y_mm[i]) >= exclude_mm && se > 0 && std::isfinite(v) &&
+          std::isfinite(se)) {
         idx.push_back(i);
       }
     }
@@ -276,11 +297,15 @@ Observations observations_for(const ProfileData& d, int c, double exclude_mm, bo
         std::max<std::size_t>(1, (idx.size() + q.max_samples_2d - 1) / q.max_samples_2d);
     for (std::size_t k = 0; k < idx.size(); k += stride) {
       const std::size_t i = idx[k];
+      const double v = s.value[c][i], se = s.standard_error[c][i];
       o.x.push_back(s.x_mm[i]);
       o.y.push_back(s.y_mm[i]);
-      o.log_value.push_back(std::log(s.value[c][i]));
-      o.inv_rel_se.push_back(s.value[c][i] / s.standard_error[c][i]);
-      o.data_rel_se.push_back(s.standard_error[c][i] / s.value[c][i]);
+      o.log_value.push_back(std::log(std::max(v, se)));
+      o.inv_rel_se.push_back(std::max(v, se) / se);
+      o.data_rel_se.push_back(se / std::max(v, se));
+      o.value.push_back(v);
+      o.inv_se.push_back(1 / se);
+      o.data_se.push_back(se);
     }
   } else {
     const RadialBins& b = d.radial;
@@ -360,6 +385,12 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
   std::array<int, 3> samples{};
   std::array<double, 3> range_end{};
   std::vector<std::pair<int, int>> block_channels;  // (channel, residuals) in insertion order
+  std::vector<const Observations*> block_obs;       // each block's samples (null: a prior)
+  // Each residual block's samples, recorded beside block_channels.
+  const auto record = [&](int c, const Observations* o, int count) {
+    block_channels.emplace_back(c, count);
+    block_obs.push_back(o);
+  };
   std::vector<std::pair<double*, std::string>> calibration_blocks;
   for (std::size_t di = 0; di < data.size(); ++di) {
     const ProfileData& d = data[di];
@@ -369,19 +400,36 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
       if (!channels[c] || !d.channels[c]) continue;
       p.observations.push_back(observations_for(d, c, exclude[c], use_2d, q, below_noise));
       Observations& o = p.observations.back();
+      o.capture = int(di);
       if (o.log_value.empty()) continue;
       for (std::size_t i = 0; i < o.log_value.size(); ++i)
-        range_end[c] = std::max(range_end[c], o.radial ? o.r[i] : std::hypot(o.x[i], o.y[i]));
+        if (!o.linear || o.value[i] >= 2 * o.data_se[i])  // the reach: samples above the noise
+          range_end[c] = std::max(range_end[c], o.radial ? o.r[i] : std::hypot(o.x[i], o.y[i]));
       if (model == FitModel::kTabulated) {
         // The table's own Monte Carlo error joins the data's in each weight (at the start
         // values: the weights stay fixed during the solve).
         const double st = start[c].sigma_a + start[c].sigma_s_reduced;
         const double alpha = start[c].sigma_s_reduced / st;
+        const materials::ObliqueProfile* ob =
+            !o.radial && o.geometry.cos_incidence < 0.9999 ? table->oblique() : nullptr;
+        double tx = -o.geometry.w_i[0], ty = -o.geometry.w_i[1];
+        if (const double len = std::hypot(tx, ty); len > 0) tx /= len, ty /= len;
         for (std::size_t i = 0; i < o.log_value.size(); ++i) {
           const double r = o.radial ? o.r[i] : std::hypot(o.x[i], o.y[i]);
-          const double t = table->relative_se(detail::table_quantity(o.geometry), r * st, alpha, eta0);
+          const auto q = detail::table_quantity(o.geometry);
+          const double t =
+              ob ? ob->relative_se(q, r * st,
+                                   std::atan2(std::abs(-o.x[i] * ty + o.y[i] * tx),
+                                              o.x[i] * tx + o.y[i] * ty),
+                                   alpha)
+                 : table->relative_se(q, r * st, alpha, eta0);
           const double d2 = o.data_rel_se[i] * o.data_rel_se[i];
           o.inv_rel_se[i] = std::isfinite(t) ? 1.0 / std::sqrt(d2 + t * t) : 1e-3 / std::sqrt(d2);
+          if (o.linear) {  // the table's relative error of a value about max(value, se)
+            const double m = std::max(o.value[i], o.data_se[i]);
+            o.inv_se[i] = std::isfinite(t) ? 1.0 / std::hypot(o.data_se[i], t * m)
+                                           : 1e-3 / o.data_se[i];
+          }
         }
       }
       samples[c] += int(o.log_value.size());
@@ -394,27 +442,27 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
         problem.AddResidualBlock(
             new ceres::AutoDiffCostFunction<ScalePrior, 1, 1>(new ScalePrior{1.0 / cal_se}),
             nullptr, scale);
-        block_channels.emplace_back(-1, 1);  // the prior's residual: not a sample
+        record(-1, nullptr, 1);  // the prior's residual: not a sample
         calibration_blocks.emplace_back(
             scale, std::string("log calibration[") + kChannelNames[c] +
                        (data.size() > 1 ? ", input " + std::to_string(di + 1) : "") + "]");
       }
       const bool scale_free = scale != &p.log_scale || relative;
       if (options.loss == LossKind::kNone && !options.fit_ior && options.analytic_derivatives &&
-          model == FitModel::kDipole) {
+          model == FitModel::kDipole && !o.linear) {
         problem.AddResidualBlock(new DipoleRadialCost(&o, gl, &p.eta), nullptr, p.ab[c].data(),
                                  scale);
-        block_channels.emplace_back(c, int(o.log_value.size()));
+        record(c, &o, int(o.log_value.size()));
       } else if (options.loss == LossKind::kNone && !options.fit_ior && !scale_free) {
         auto* cost = new ceres::AutoDiffCostFunction<ChannelResiduals, ceres::DYNAMIC, 2>(
             new ChannelResiduals{{&o, model, gl, table, perturbation}, scale, &p.eta}, int(o.log_value.size()));
         problem.AddResidualBlock(cost, nullptr, p.ab[c].data());
-        block_channels.emplace_back(c, int(o.log_value.size()));
+        record(c, &o, int(o.log_value.size()));
       } else if (options.loss == LossKind::kNone) {
         auto* cost = new ceres::AutoDiffCostFunction<ProfileResiduals, ceres::DYNAMIC, 2, 1, 1>(
             new ProfileResiduals{&o, model, gl, table, perturbation}, int(o.log_value.size()));
         problem.AddResidualBlock(cost, nullptr, p.ab[c].data(), scale, &p.eta);
-        block_channels.emplace_back(c, int(o.log_value.size()));
+        record(c, &o, int(o.log_value.size()));
       } else {
         // A robust loss acts on each sample, so each gets its own block.
         for (std::size_t i = 0; i < o.log_value.size(); ++i) {
@@ -431,6 +479,9 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
           pick(one.log_value);
           pick(one.inv_rel_se);
           pick(one.data_rel_se);
+          pick(one.value);
+          pick(one.inv_se);
+          pick(one.data_se);
           auto* cost = new ceres::AutoDiffCostFunction<ProfileResiduals, ceres::DYNAMIC, 2, 1, 1>(
               new ProfileResiduals{&one, model, gl, table, perturbation}, 1);
           ceres::LossFunction* loss =
@@ -438,7 +489,7 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
                   ? static_cast<ceres::LossFunction*>(new ceres::HuberLoss(options.loss_scale))
                   : new ceres::CauchyLoss(options.loss_scale);
           problem.AddResidualBlock(cost, loss, p.ab[c].data(), scale, &p.eta);
-          block_channels.emplace_back(c, 1);
+          record(c, &one, 1);
         }
       }
     }
@@ -576,12 +627,34 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
     std::size_t offset = 0;
     std::array<double, 3> chi2{};
     std::array<std::vector<double>, 3> magnitudes;  // |residual| per sample, for the median
-    for (const auto& [c, count] : block_channels) {
+    // Single pixels' noise is not independent from pixel to pixel (a simulated capture's Monte
+    // Carlo noise: one photon path scores along millimetres; a real sample's texture), nor always
+    // as small as the camera model says. The design effect measures both: over square cells of
+    // side L, D = sum (sum of a cell's residuals)^2 / samples, 1 for independent residuals of unit
+    // variance. The largest D over L = 1, 2, 4, 8 mm scales the statistical variance like the Birge
+    // ratio does (which is D at L = 0).
+    std::array<double, 3> design{1.0, 1.0, 1.0};
+    std::array<std::map<std::tuple<int, double, long, long>, double>, 3> cells;
+    std::array<int, 3> pixel_samples{};
+    for (std::size_t b = 0; b < block_channels.size(); ++b) {
+      const auto [c, count] = block_channels[b];
+      const Observations* o = block_obs[b];
       for (int i = 0; i < count; ++i, ++offset) {
         if (c < 0) continue;
         chi2[c] += residuals[offset] * residuals[offset];
         magnitudes[c].push_back(std::abs(residuals[offset]));
+        if (!o || !o->linear) continue;
+        ++pixel_samples[c];
+        for (double side : {1.0, 2.0, 4.0, 8.0})
+          cells[c][{o->capture, side, long(std::floor(o->x[i] / side)),
+                    long(std::floor(o->y[i] / side))}] += residuals[offset];
       }
+    }
+    for (int c = 0; c < 3; ++c) {
+      if (pixel_samples[c] < 50) continue;
+      std::map<double, double> sum2;
+      for (const auto& [key, sum] : cells[c]) sum2[std::get<1>(key)] += sum * sum;
+      for (const auto& [side, ss] : sum2) design[c] = std::max(design[c], ss / pixel_samples[c]);
     }
     for (int c = 0; c < 3; ++c) {
       std::vector<double>& m = magnitudes[c];
@@ -600,7 +673,8 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
       // Lack of fit: a reduced chi^2 above 1 says the residuals are larger than the standard
       // errors allow, so the statistical spread is that much larger (Birge ratio).
       ch.reduced_chi2 = samples[c] > 2 ? chi2[c] / (samples[c] - 2) : 0.0;
-      const double birge = std::sqrt(std::max(1.0, ch.reduced_chi2));
+      ch.design_effect = design[c];
+      const double birge = std::sqrt(std::max({1.0, ch.reduced_chi2, design[c]}));
       ch.sd_sigma_a *= birge;
       ch.sd_sigma_s_reduced *= birge;
       ch.sd_stat_sigma_a = ch.sd_sigma_a;

@@ -11,6 +11,7 @@
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/directional_dipole.h"
 #include "lucent/materials/fresnel.h"
+#include "lucent/materials/oblique.h"
 #include "lucent/materials/tabulated.h"
 
 namespace lucent::fit::detail {
@@ -180,6 +181,29 @@ T corrected_ddipole_pixel(const materials::TabulatedModel<T>& tab,
   return sum;
 }
 
+/// Oblique incidence with an oblique table slice at the capture's incidence (exact to transport):
+/// the table's 2D profile over a square pixel footprint centred at (x, y), the position turned
+/// into the beam's frame (travelling toward +x: the horizontal part of -w_i).
+template <typename T>
+T oblique_pixel(const materials::ObliqueModel<T>& m, materials::TableQuantity q,
+                const CaptureGeometry& g, double x, double y, double pixel,
+                const GaussLegendre& gl) {
+  double tx = -g.w_i[0], ty = -g.w_i[1];
+  const double len = std::hypot(tx, ty);
+  if (len > 0) tx /= len, ty /= len;
+  else tx = 1, ty = 0;
+  const auto at = [&](double px, double py) {
+    return m.at(q, px * tx + py * ty, -px * ty + py * tx);
+  };
+  if (!(pixel > 0)) return at(x, y);
+  T sum(0);
+  for (int a = 0; a < gl.order; ++a)
+    for (int b = 0; b < gl.order; ++b)
+      sum += gl.weight[a] * gl.weight[b] *
+             at(x + (gl.node[a] - 0.5) * pixel, y + (gl.node[b] - 0.5) * pixel);
+  return sum;
+}
+
 /// One sample's model value (before fresnel_factor): a radial bin (annulus, or a pixel footprint
 /// at the bin's radius when `pixel` > 0 and not `radial`) or a 2D pixel.
 template <typename T>
@@ -192,8 +216,11 @@ T model_value(FitModel model, const materials::TabulatedProfile* table,
       return radial ? dipole_annulus(dipole, r, r0, r1, gl) : dipole_pixel(dipole, x, y, pixel, gl);
     }
     case FitModel::kTabulated: {
-      const materials::TabulatedModel<T> tab(*table, medium);
       const materials::TableQuantity q = table_quantity(g);
+      if (!radial && g.cos_incidence < 0.9999 && table->oblique())
+        return oblique_pixel(materials::ObliqueModel<T>(*table->oblique(), medium), q, g, x, y,
+                             pixel, gl);
+      const materials::TabulatedModel<T> tab(*table, medium);
       if (!radial && g.cos_incidence < 0.9999)
         return corrected_ddipole_pixel(tab, materials::DirectionalDipole<T>(medium), q, g, x, y,
                                        pixel, gl);

@@ -10,9 +10,10 @@
 #include <sstream>
 
 #include "lucent/materials/error.h"
+#include "lucent/materials/oblique.h"
 
 namespace lucent::materials {
-namespace {
+namespace detail {
 
 // Annulus averages -> point values at the bins' log centres. The file holds what Monte Carlo
 // measures, the mean over each annulus; the interpolant needs point values, and in a steep far
@@ -47,10 +48,15 @@ void to_point_values(std::vector<double>& f, const std::vector<double>& x,
   f = p;
 }
 
-}  // namespace
+}  // namespace detail
+
+using detail::to_point_values;
 
 TabulatedProfile::TabulatedProfile(const TransportTable& table, double g) : g_(g) {
   if (table.partial) throw Error(table.source + ": a partial table (merge the shards first)");
+  if (table.grid.phi_bins != 1)
+    throw Error(table.source + ": an oblique table (2D, " + std::to_string(table.grid.phi_bins) +
+                " azimuths): give it as --oblique-table, not as the radial --table");
   std::map<double, std::vector<const TransportTableSlice*>> by_g;
   for (const TransportTableSlice& s : table.slices) by_g[s.g].push_back(&s);
   std::vector<double> g_nodes;
@@ -165,8 +171,15 @@ TabulatedProfile TabulatedProfile::at_eta(double eta) const {
   return p;
 }
 
+TabulatedProfile TabulatedProfile::with_oblique(std::shared_ptr<const ObliqueProfile> o) const {
+  TabulatedProfile p = *this;
+  p.oblique_ = std::move(o);
+  return p;
+}
+
 TabulatedProfile TabulatedProfile::perturbed(std::uint64_t seed) const {
   TabulatedProfile p = *this;
+  if (oblique_) p.oblique_ = std::make_shared<const ObliqueProfile>(oblique_->perturbed(seed + 7919));
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal(0.0, 1.0);
   for (std::size_t s = 0; s < p.f_.size(); ++s) {

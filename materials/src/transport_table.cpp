@@ -17,6 +17,7 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <tuple>
 
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
@@ -69,7 +70,14 @@ json grid_json(const TransportTableGrid& g) {
           {"rho_min", g.rho_min},
           {"rho_max", g.rho_max},
           {"rho_per_decade", g.rho_per_decade},
-          {"rho_bins", g.rho_bins()}};
+          {"rho_bins", g.rho_bins()},
+          {"phi_bins", g.phi_bins}};
+}
+
+json slice_json(double eta, double g, std::uint64_t photons, double incidence_deg) {
+  json s = {{"eta", eta}, {"g", g}, {"photons", photons}};
+  if (incidence_deg != 0) s["incidence_deg"] = incidence_deg;
+  return s;
 }
 
 // Fills the far tail of one row (fixed u) past its last measured bin, where too few photons
@@ -145,6 +153,17 @@ TransportTableGrid default_transport_grid() {
   return g;
 }
 
+TransportTableGrid default_oblique_grid() {
+  // Coarser in rho than the radial table (an oblique capture's fit starts beyond two pixels, rho
+  // of ~1 for marble): 16 bins per decade from 0.05, deconvolved like the radial ones; 15-degree
+  // wedges, where the asymmetry of a 45-degree beam changes by a few percent from one to the next.
+  TransportTableGrid g = default_transport_grid();
+  g.rho_min = 0.05;
+  g.rho_per_decade = 16;
+  g.phi_bins = 12;
+  return g;
+}
+
 std::uint8_t encode_relative_se(double rel, bool extrapolated) {
   if (extrapolated || !std::isfinite(rel)) return kExtrapolatedEntry;
   const double code = std::round(200 + 40 * std::log10(std::max(rel, 1e-5)));
@@ -157,8 +176,9 @@ double decode_relative_se(std::uint8_t code) {
 
 void finish_transport_table(TransportTable& table, const std::vector<TransportTableGroup>& groups) {
   const std::size_t K = table.grid.u.size();
+  const std::size_t rows = table.grid.rows();
   const int J = table.grid.rho_bins();
-  const std::size_t n = K * std::size_t(J);
+  const std::size_t n = rows * std::size_t(J);
   std::vector<std::vector<const TransportTableGroup*>> by_slice(table.slice_axes.size());
   for (const TransportTableGroup& g : groups) {
     if (g.slice < 0 || std::size_t(g.slice) >= by_slice.size())
@@ -182,6 +202,7 @@ void finish_transport_table(TransportTable& table, const std::vector<TransportTa
     slice.eta = table.slice_axes[s][0];
     slice.g = table.slice_axes[s][1];
     slice.photons = std::uint64_t(table.slice_axes[s][2]);
+    slice.incidence_deg = table.slice_axes[s][3];
     for (int q = 0; q < kTableQuantities; ++q) {
       std::vector<double> mean(n, 0.0), rel(n, 0.0);
       for (std::size_t e = 0; e < n; ++e) {
@@ -197,7 +218,7 @@ void finish_transport_table(TransportTable& table, const std::vector<TransportTa
       }
       slice.value[std::size_t(q)].resize(n);
       slice.se_code[std::size_t(q)].resize(n);
-      for (std::size_t k = 0; k < K; ++k) {
+      for (std::size_t k = 0; k < rows; ++k) {
         std::vector<double> v(mean.begin() + long(k * J), mean.begin() + long((k + 1) * J));
         std::vector<double> r(rel.begin() + long(k * J), rel.begin() + long((k + 1) * J));
         std::vector<bool> extrapolated(std::size_t(J), false);
@@ -232,7 +253,7 @@ void write_transport_table(const TransportTable& t, const std::filesystem::path&
   json slices = json::array();
   if (!t.partial) {
     for (const TransportTableSlice& s : t.slices) {
-      slices.push_back({{"eta", s.eta}, {"g", s.g}, {"photons", s.photons}});
+      slices.push_back(slice_json(s.eta, s.g, s.photons, s.incidence_deg));
       for (int q = 0; q < kTableQuantities; ++q) {
         put(payload, s.value[std::size_t(q)].data(), n);
         put(payload, s.se_code[std::size_t(q)].data(), n);
@@ -242,7 +263,7 @@ void write_transport_table(const TransportTable& t, const std::filesystem::path&
     }
   } else {
     for (const auto& a : t.slice_axes)
-      slices.push_back({{"eta", a[0]}, {"g", a[1]}, {"photons", std::uint64_t(a[2])}});
+      slices.push_back(slice_json(a[0], a[1], std::uint64_t(a[2]), a[3]));
   }
   json groups = json::array();
   for (const TransportTableGroup& g : t.partial_groups) {
@@ -255,11 +276,17 @@ void write_transport_table(const TransportTable& t, const std::filesystem::path&
       {"version", kVersion},
       {"kind", t.partial ? "partial" : "table"},
       {"description",
-       "radial profile of a semi-infinite slab under a normally incident pencil beam, per unit "
-       "power entering, white Monte Carlo (lucent tabulate)"},
+       t.grid.phi_bins > 1
+           ? "2D profile of a semi-infinite slab under an oblique pencil beam travelling toward +x "
+             "(bins in rho and in phi = atan2(|y|, x)), per unit power entering, white Monte "
+             "Carlo (lucent tabulate)"
+           : "radial profile of a semi-infinite slab under a normally incident pencil beam, per "
+             "unit power entering, white Monte Carlo (lucent tabulate)"},
       {"units",
        {{"rho", "r sigma_t' (dimensionless)"},
         {"u", "sqrt(1 - alpha'), alpha' = sigma_s' / sigma_t'"},
+        {"phi", "azimuth from the beam's direction of travel, [0, pi] in phi_bins wedges"},
+        {"incidence_deg", "the beam's angle from the normal outside the medium, degrees"},
         {"exitance", "R(r) / sigma_t'^2: power per unit area leaving the surface, bin average"},
         {"radiance", "pi L(r, normal) / sigma_t'^2: pi times the radiance along the normal"},
         {"total", "total diffuse reflectance (whole plane), per unit power entering"}}},
@@ -270,9 +297,9 @@ void write_transport_table(const TransportTable& t, const std::filesystem::path&
       {"max_path", t.max_path},
       {"generator", t.generator},
       {"layout", t.partial
-                     ? "per group: float64 exitance[u][rho], radiance[u][rho], total[u]"
-                     : "per slice: for exitance then radiance float32 value[u][rho], uint8 "
-                       "se_code[u][rho] (relative SE 10^((code-200)/40), 255 = extrapolated "
+                     ? "per group: float64 exitance[u][phi][rho], radiance[u][phi][rho], total[u]"
+                     : "per slice: for exitance then radiance float32 value[u][phi][rho], uint8 "
+                       "se_code[u][phi][rho] (relative SE 10^((code-200)/40), 255 = extrapolated "
                        "tail); then float64 total[u], total_se[u]"},
       {"payload_bytes", payload.size()},
       {"crc32", crc32(0L, reinterpret_cast<const Bytef*>(payload.data()), uInt(payload.size()))}};
@@ -346,6 +373,7 @@ TransportTable read_transport_table_unchecked(const std::filesystem::path& path)
     t.grid.rho_min = g.at("rho_min").get<double>();
     t.grid.rho_max = g.at("rho_max").get<double>();
     t.grid.rho_per_decade = whole_number<int>(g.at("rho_per_decade"), src, "rho_per_decade");
+    if (g.contains("phi_bins")) t.grid.phi_bins = whole_number<int>(g.at("phi_bins"), src, "phi_bins");
     t.groups = whole_number<int>(field("groups"), src, "groups");
     t.seed = whole_number<std::uint64_t>(field("seed"), src, "seed");
     t.max_path = field("max_path").get<double>();
@@ -353,20 +381,25 @@ TransportTable read_transport_table_unchecked(const std::filesystem::path& path)
     t.partial = field("kind").get<std::string>() == "partial";
     for (const json& s : field("slices"))
       t.slice_axes.push_back({s.at("eta").get<double>(), s.at("g").get<double>(),
-                              double(whole_number<std::uint64_t>(s.at("photons"), src, "photons"))});
+                              double(whole_number<std::uint64_t>(s.at("photons"), src, "photons")),
+                              s.value("incidence_deg", 0.0)});
   } catch (const json::exception& e) {
     throw Error(src + ": grid, slices or groups: unexpected value (" + std::string(e.what()) + ")");
   }
   bool grid_ok = t.grid.u.size() >= 2 && t.grid.u.size() <= 4096 && t.grid.u.front() == 0 &&
                  t.grid.rho_min > 0 && t.grid.rho_max > t.grid.rho_min &&
-                 t.grid.rho_per_decade >= 1 && t.grid.rho_per_decade <= 200 && t.groups >= 2;
+                 t.grid.rho_per_decade >= 1 && t.grid.rho_per_decade <= 200 && t.groups >= 2 &&
+                 t.grid.phi_bins >= 1 && t.grid.phi_bins <= 360;
   for (std::size_t k = 1; grid_ok && k < t.grid.u.size(); ++k)
     grid_ok = t.grid.u[k] > t.grid.u[k - 1] && t.grid.u[k] < 1;
-  if (!grid_ok) throw Error(src + ": grid: expected rising u nodes in [0, 1) and a rho range");
+  if (!grid_ok)
+    throw Error(src + ": grid: expected rising u nodes in [0, 1), a rho range and 1..360 phi_bins");
   if (t.slice_axes.empty()) throw Error(src + ": slices: expected at least one");
   for (const auto& a : t.slice_axes)
-    if (!(a[0] >= 1 && a[0] <= 2.5 && a[1] >= 0 && a[1] < 1 && a[2] >= 1))
-      throw Error(src + ": slices: eta in [1, 2.5], g in [0, 1) and photons >= 1 expected");
+    if (!(a[0] >= 1 && a[0] <= 2.5 && a[1] >= 0 && a[1] < 1 && a[2] >= 1 && a[3] >= 0 &&
+          a[3] < 90))
+      throw Error(src + ": slices: eta in [1, 2.5], g in [0, 1), photons >= 1 and "
+                  "incidence_deg in [0, 90) expected");
 
   std::string payload((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::uint64_t declared = whole_number<std::uint64_t>(field("payload_bytes"), src, "payload_bytes");
@@ -383,7 +416,7 @@ TransportTable read_transport_table_unchecked(const std::filesystem::path& path)
   if (!t.partial) {
     for (const auto& a : t.slice_axes) {
       TransportTableSlice s;
-      s.eta = a[0], s.g = a[1], s.photons = std::uint64_t(a[2]);
+      s.eta = a[0], s.g = a[1], s.photons = std::uint64_t(a[2]), s.incidence_deg = a[3];
       for (int q = 0; q < kTableQuantities; ++q) {
         s.value[std::size_t(q)].resize(n);
         s.se_code[std::size_t(q)].resize(n);
@@ -453,15 +486,20 @@ TransportTable merge_transport_tables(const std::vector<TransportTable>& parts) 
     out.slices.clear();
   }
   out.slices.insert(out.slices.end(), slices.begin(), slices.end());
-  std::sort(out.slices.begin(), out.slices.end(), [](const auto& a, const auto& b) {
-    return a.g != b.g ? a.g < b.g : a.eta < b.eta;
-  });
+  const auto key = [](const TransportTableSlice& s) {
+    return std::tuple(s.incidence_deg, s.g, s.eta);
+  };
+  std::sort(out.slices.begin(), out.slices.end(),
+            [&](const auto& a, const auto& b) { return key(a) < key(b); });
   for (std::size_t i = 1; i < out.slices.size(); ++i)
-    if (out.slices[i].g == out.slices[i - 1].g && out.slices[i].eta == out.slices[i - 1].eta)
+    if (key(out.slices[i]) == key(out.slices[i - 1]))
       throw Error("merge: the slice eta=" + std::to_string(out.slices[i].eta) +
-                  " g=" + std::to_string(out.slices[i].g) + " is given twice");
+                  " g=" + std::to_string(out.slices[i].g) +
+                  " incidence_deg=" + std::to_string(out.slices[i].incidence_deg) +
+                  " is given twice");
   out.slice_axes.clear();
-  for (const auto& s : out.slices) out.slice_axes.push_back({s.eta, s.g, double(s.photons)});
+  for (const auto& s : out.slices)
+    out.slice_axes.push_back({s.eta, s.g, double(s.photons), s.incidence_deg});
   out.partial = false;
   out.shard.clear();
   out.source.clear();
@@ -471,6 +509,11 @@ TransportTable merge_transport_tables(const std::vector<TransportTable>& parts) 
 std::filesystem::path default_transport_table_path() {
   if (const char* env = std::getenv("LUCENT_TRANSPORT_TABLE"); env && *env) return env;
   return std::filesystem::path(LUCENT_TABLE_DIR) / "transport.lut";
+}
+
+std::filesystem::path default_oblique_table_path() {
+  if (const char* env = std::getenv("LUCENT_OBLIQUE_TABLE"); env && *env) return env;
+  return std::filesystem::path(LUCENT_TABLE_DIR) / "oblique.lut";
 }
 
 const TransportTable& default_transport_table() {

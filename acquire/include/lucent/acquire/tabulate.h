@@ -14,6 +14,8 @@ namespace lucent::acquire {
 struct TabulateOptions {
   std::vector<double> eta{1.0, 1.1, 1.2, 1.3, 1.4, 1.5, 1.6};  ///< relative indices, each in [1, 2.5]
   std::vector<double> g{0.0};           ///< Henyey-Greenstein mean cosines, each in [0, 0.95]
+  /// Incidence angles from the normal (degrees, [0, 85]); any > 0 needs grid.phi_bins > 1.
+  std::vector<double> incidence_deg{0.0};
   materials::TransportTableGrid grid = materials::default_transport_grid();
   std::uint64_t photons = 1'000'000;    ///< per slice (rounded up to a multiple of groups)
   std::uint64_t seed = 1;

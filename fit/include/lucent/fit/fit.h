@@ -40,6 +40,10 @@ struct FitOptions {
   double g = 0;
   /// The transport table; null: the shipped one (materials::default_transport_table()).
   const materials::TransportTable* table = nullptr;
+  /// An oblique table (lucent tabulate --incidence-deg) holding the slice at the data's eta, g
+  /// and incidence: 2D oblique data are then fitted with it, exact to transport. Null, or no
+  /// such slice: the directional dipole corrected by the radial table (a note says so).
+  const materials::TransportTable* oblique_table = nullptr;
   /// The model-error work beside the solve: a diffusion model's cross-fit of the tabulated model,
   /// the tabulated model's bootstrap over its table and accuracy refits, the g = 0.9 refit, the
   /// adequacy of cheaper models. Off only to time the solve alone (bench_fit).
@@ -74,14 +78,19 @@ struct ChannelFit {
   double sigma_a = 0, sigma_s_reduced = 0;  ///< mm^-1
   /// Total standard deviations, mm^-1 (0 when fixed): statistical and systematic in quadrature.
   double sd_sigma_a = 0, sd_sigma_s_reduced = 0;
-  /// Statistical: from the Jacobian (calibration priors included), scaled by sqrt(reduced chi^2)
-  /// when it exceeds 1 (lack of fit).
+  /// Statistical: from the Jacobian (calibration priors included), scaled by the square root of
+  /// the larger of the reduced chi^2 (lack of fit) and, for single pixels, the design effect,
+  /// when it exceeds 1.
   double sd_stat_sigma_a = 0, sd_stat_sigma_s_reduced = 0;
   /// Systematic: the model's own error; for a diffusion model its difference from the tabulated
   /// model on the same data (0 for the tabulated model, whose table error enters the statistical
   /// part through the weights).
   double sd_sys_sigma_a = 0, sd_sys_sigma_s_reduced = 0;
   double reduced_chi2 = 0;
+  /// Single pixels (2D samples): the variance of the residuals' sums over 1-8 mm cells relative
+  /// to independent unit-variance noise (pixel-to-pixel correlated or unmodelled noise); 1
+  /// otherwise.
+  double design_effect = 1;
   /// This channel's usable range: exclusion radius and the last bin above the noise floor, mm.
   double exclude_radius_mm = 0, range_end_mm = 0;
   /// The usable range in diffuse mean free paths 1 / sigma_tr (the fit's sigma_tr).

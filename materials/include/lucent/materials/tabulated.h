@@ -148,7 +148,7 @@ NodeWeights<T> uniform_hermite_weights(double x0, double h, int n, const T& t) {
 /// linear in ln rho below the first centre, linear in rho beyond the last (falling only: beyond
 /// the table a profile cannot rise).
 template <typename T>
-T interpolate_row(const std::vector<double>& x, const std::vector<T>& row, const T& rho) {
+T interpolate_row(const std::vector<double>& x, const T* row, const T& rho) {
   using std::log;
   const std::size_t J = x.size();
   const T lr = log(rho);
@@ -162,6 +162,19 @@ T interpolate_row(const std::vector<double>& x, const std::vector<T>& row, const
   for (int c = 0; c < w.count; ++c) sum += w.w[std::size_t(c)] * row[std::size_t(w.first + c)];
   return sum;
 }
+template <typename T>
+T interpolate_row(const std::vector<double>& x, const std::vector<T>& row, const T& rho) {
+  return interpolate_row(x, row.data(), rho);
+}
+
+namespace detail {
+/// Annulus averages of a row of logs over the grid's radius bins -> point values at the bins'
+/// log centres x (in place).
+void to_point_values(std::vector<double>& f, const std::vector<double>& x,
+                     const TransportTableGrid& grid);
+}  // namespace detail
+
+class ObliqueProfile;
 
 /// A transport table at one g, ready to evaluate: log(value / alpha') at the point centres of the
 /// radius bins (the annulus averages of the file turned into point values by a second-order
@@ -177,6 +190,10 @@ class TabulatedProfile {
   /// error (seeded): one realisation of the table's Monte Carlo noise, for propagating it into a
   /// fit by a parametric bootstrap.
   TabulatedProfile perturbed(std::uint64_t seed) const;
+  /// A copy carrying an oblique slice (oblique.h) for 2D data at that incidence: the fit uses it
+  /// in place of the corrected directional dipole (and perturbs it with the rest).
+  TabulatedProfile with_oblique(std::shared_ptr<const ObliqueProfile> oblique) const;
+  const ObliqueProfile* oblique() const { return oblique_.get(); }
 
   double g() const { return g_; }
   double eta_min() const { return eta_.front(); }
@@ -273,6 +290,7 @@ class TabulatedProfile {
   std::vector<std::array<std::vector<float>, kTableQuantities>> rel_se_;
   std::vector<std::vector<double>> log_total_;  // [slice][k]: log(total / alpha')
   std::vector<std::vector<double>> total_rel_se_;  // [slice][k]
+  std::shared_ptr<const ObliqueProfile> oblique_;
 };
 
 /// A prepared profile of `table` at g (and, when given, at a fixed eta), made once per (table, g,

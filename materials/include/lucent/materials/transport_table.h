@@ -2,6 +2,10 @@
 // semi-infinite slab under a normally incident pencil beam, from lucent's Monte Carlo simulator,
 // in optical units (radius times sigma_t', reduced albedo alpha') per relative index eta and
 // Henyey-Greenstein g. This header is the data and its file; `tabulated.h` interpolates it.
+// An oblique table (`phi_bins` > 1, slices with an incidence angle) holds the 2D profile of a
+// beam arriving at incidence_deg from the normal, travelling toward +x: each radius bin split
+// into phi_bins wedges of azimuth phi = atan2(|y|, x) in [0, pi] (the profile is even in y);
+// `oblique.h` interpolates it.
 //
 // File (`lucent-transport-table`, version 1): one line of JSON describing everything (format,
 // version, units, grid, photons and seed per slice, payload layout and its CRC-32), a newline, then
@@ -40,16 +44,23 @@ struct TransportTableGrid {
   double rho_min = 0.01;
   double rho_max = 100;
   int rho_per_decade = 20;
+  /// Azimuth wedges per radius bin over [0, pi]: 1 for a radial (normal-incidence) table.
+  int phi_bins = 1;
 
   int rho_bins() const;
   double rho_edge(int j) const;    ///< j in [0, rho_bins()]
   double rho_centre(int j) const;  ///< geometric centre of bin j
-  std::size_t entries() const { return u.size() * std::size_t(rho_bins()); }
+  /// Rows of rho_bins() entries: one per (u node, azimuth wedge), index k * phi_bins + p.
+  std::size_t rows() const { return u.size() * std::size_t(phi_bins); }
+  std::size_t entries() const { return rows() * std::size_t(rho_bins()); }
   bool operator==(const TransportTableGrid&) const = default;
 };
 
 /// The default grid of the shipped table.
 TransportTableGrid default_transport_grid();
+/// The default grid of an oblique table: the same albedo nodes, rho 0.05..100 at 16 per decade,
+/// 12 azimuth wedges of 15 degrees.
+TransportTableGrid default_oblique_grid();
 
 /// Standard-error code: 255 marks an entry with no Monte Carlo support (its value is a far-tail
 /// extrapolation); otherwise the relative standard error is 10^((code - 200) / 40), 1e-5 to ~20,
@@ -58,12 +69,14 @@ std::uint8_t encode_relative_se(double relative_se, bool extrapolated);
 double decode_relative_se(std::uint8_t code);  ///< infinity for 255
 inline constexpr std::uint8_t kExtrapolatedEntry = 255;
 
-/// One (eta, g) slice.
+/// One (eta, g, incidence) slice.
 struct TransportTableSlice {
   double eta = 1;
   double g = 0;
+  double incidence_deg = 0;  ///< the beam's angle from the normal, outside the medium
   std::uint64_t photons = 0;  ///< photons behind every entry of the slice
-  /// [quantity][k * rho_bins + j]: bin-average value and standard-error code.
+  /// [quantity][row * rho_bins + j] (rows as TransportTableGrid::rows()): bin-average value and
+  /// standard-error code.
   std::array<std::vector<float>, kTableQuantities> value;
   std::array<std::vector<std::uint8_t>, kTableQuantities> se_code;
   /// Per u node: total diffuse reflectance (exitance over the whole plane) and its standard error.
@@ -89,8 +102,8 @@ struct TransportTable {
   bool partial = false;                     ///< a shard: groups instead of slices
   std::string shard;                        ///< "I/N" for a shard
   std::vector<TransportTableGroup> partial_groups;
-  /// Slice axes of a partial file (eta, g, photons per slice), the slices' order.
-  std::vector<std::array<double, 3>> slice_axes;
+  /// Slice axes (eta, g, photons per slice, incidence in degrees), the slices' order.
+  std::vector<std::array<double, 4>> slice_axes;
   std::string source;  ///< where it was read from
 };
 
@@ -110,5 +123,8 @@ void finish_transport_table(TransportTable& table, const std::vector<TransportTa
 /// The table lucent ships (materials/tables/transport.lut, or $LUCENT_TRANSPORT_TABLE), read once.
 const TransportTable& default_transport_table();
 std::filesystem::path default_transport_table_path();
+/// The oblique table lucent ships (materials/tables/oblique.lut, or $LUCENT_OBLIQUE_TABLE): the
+/// slices the bundled captures need.
+std::filesystem::path default_oblique_table_path();
 
 }  // namespace lucent::materials
