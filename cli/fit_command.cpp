@@ -189,7 +189,8 @@ void register_fit_command(CLI::App& app) {
   cmd->add_option("--oblique-table", args->oblique_table,
                   "oblique transport table (lucent tabulate --incidence-deg) for 2D captures at "
                   "oblique incidence (default: the shipped one when it holds the capture's eta, "
-                  "g and incidence, else one built now and kept in ~/.cache/lucent)");
+                  "g and incidence, else one built now and kept in ~/.cache/lucent; none: the directional "
+                  "dipole corrected by the radial table, fast and approximate)");
   cmd->add_option("--oblique-photons", args->oblique_photons,
                   "photons of an oblique table built for this fit (about 50 s per million on "
                   "2 cores)")

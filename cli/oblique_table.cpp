@@ -17,7 +17,7 @@ namespace lucent::cli {
 std::optional<materials::TransportTable> oblique_table_for(
     const std::vector<fit::ProfileData>& data, const fit::FitOptions& options,
     const std::string& given, std::uint64_t photons, bool quiet) {
-  if (options.fit_ior || options.model == fit::FitModel::kDipole ||
+  if (given == "none" || options.fit_ior || options.model == fit::FitModel::kDipole ||
       options.model == fit::FitModel::kDirectionalDipole)
     return std::nullopt;
   std::optional<double> incidence;

@@ -12,7 +12,7 @@
 namespace lucent::cli {
 
 /// The table holding the slice (eta, g, incidence) of these data, or nothing when they need none
-/// (radial data, a dipole model, --fit-ior). In order: `given` (--oblique-table; an error when it
+/// (radial data, a dipole model, --fit-ior, `given` "none"). In order: `given` (--oblique-table; an error when it
 /// lacks the slice), the shipped table, the cache (materials::oblique_cache_dir()), else the slice
 /// is built now with `photons` photons (progress on stderr unless quiet) and kept in the cache.
 std::optional<materials::TransportTable> oblique_table_for(
