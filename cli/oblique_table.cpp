@@ -45,7 +45,8 @@ std::optional<materials::TransportTable> oblique_table_for(
     if (has(t)) return t;
   }
   std::ostringstream name;
-  name << "oblique-eta" << *eta << "-g" << g << "-inc" << *incidence << "-n" << photons << ".lut";
+  // "2": the table format whose radiance leaves the single-scattering line out.
+  name << "oblique2-eta" << *eta << "-g" << g << "-inc" << *incidence << "-n" << photons << ".lut";
   const std::filesystem::path dir = materials::oblique_cache_dir();
   const std::filesystem::path cached = dir.empty() ? std::filesystem::path() : dir / name.str();
   if (!cached.empty() && std::filesystem::exists(cached)) {

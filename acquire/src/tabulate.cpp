@@ -20,7 +20,9 @@
 // Oblique incidence (a slice's incidence_deg > 0): the photon starts along the refracted beam,
 // sin(theta_t) = sin(theta) / eta, travelling toward +x, and every tally goes to the wedge of
 // phi = atan2(|y|, x) as well as the radius bin. The white scaling is unchanged: the start
-// direction does not depend on the albedo, and scaling lengths keeps phi.
+// direction does not depend on the albedo, and scaling lengths keeps phi. The radiance leaves out
+// the first collision's next-event estimate there: single scattering of the beam is a line on
+// the surface (y = 0), which wedges cannot hold; ObliqueModel adds it in closed form.
 //
 // Standard errors come from `groups` independent photon groups per slice (the spread of the group
 // means), which is also what makes the table shardable: a shard computes some (slice, group)
@@ -100,6 +102,7 @@ void walk_photon(const Walk& m, Xoshiro256StarStar& rng, double max_path, Escape
   const SliceConstants& s = *m.slice;
   const double inv_sigma_t = 1.0 / m.sigma_t;
   double x = 0, y = 0, z = 0, ux = s.sin_t, uy = 0, uz = -s.cos_t, w = 1, path = 0;
+  bool first = true;  // no collision yet
   for (;;) {
     double step = exponential.sample(rng) * inv_sigma_t;
     while (uz > 0 && z + uz * step >= 0) {  // reaches the surface before the next collision
@@ -122,7 +125,8 @@ void walk_photon(const Walk& m, Xoshiro256StarStar& rng, double max_path, Escape
     z += uz * step;
     path += step;
     if (path > max_path) return;
-    event(x, y, path, -z, w, uz);
+    event(x, y, path, -z, w, uz, first);
+    first = false;
     if (m.albedo < 1) {
       w *= m.albedo;
       if (w < 1e-4) {
@@ -186,8 +190,9 @@ void trace_group(const SliceConstants& s, const std::vector<AlbedoNode>& nodes,
           score(&exitance, x, y, path, 1.0);
           score(nullptr, x, y, path, 1.0);
         },
-        [&](double x, double y, double path, double depth, double, double cos_up) {
+        [&](double x, double y, double path, double depth, double, double cos_up, bool first) {
           // Next-event estimate of the radiance leaving along the normal.
+          if (first && s.incidence != 0) return;  // the single-scattering line (above)
           if (s.sigma_s * depth < kMaxOpticalWeightExponent) {
             const double v = s.nee_factor * s.hg.pdf(cos_up) * std::exp(-s.sigma_s * depth);
             score(&radiance, x, y, path + depth, v);
@@ -216,7 +221,8 @@ void trace_group(const SliceConstants& s, const std::vector<AlbedoNode>& nodes,
             out.total[k] += w;
             if (const long e = bin(x, y); e >= 0) exitance[std::size_t(e)] += w;
           },
-          [&](double x, double y, double, double depth, double w, double cos_up) {
+          [&](double x, double y, double, double depth, double w, double cos_up, bool first) {
+            if (first && s.incidence != 0) return;  // the single-scattering line (above)
             const double tau = direct.sigma_t * depth;
             if (tau >= kMaxOpticalWeightExponent) return;
             if (const long e = bin(x, y); e >= 0)
@@ -286,6 +292,8 @@ materials::TransportTable tabulate_transport(const TabulateOptions& o,
   table.groups = o.groups;
   table.max_path = o.max_path;
   table.generator = std::string("lucent ") + kVersion;
+  for (double a : o.incidence_deg)
+    if (a != 0) table.single_scattering_line_excluded = true;
   const std::uint64_t per_group = (o.photons + std::uint64_t(o.groups) - 1) / std::uint64_t(o.groups);
 
   std::vector<SliceConstants> slices;

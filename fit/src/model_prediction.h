@@ -201,7 +201,9 @@ T oblique_pixel(const materials::ObliqueModel<T>& m, materials::TableQuantity q,
     for (int b = 0; b < gl.order; ++b)
       sum += gl.weight[a] * gl.weight[b] *
              at(x + (gl.node[a] - 0.5) * pixel, y + (gl.node[b] - 0.5) * pixel);
-  return sum;
+  // The beam's single-scattering line, where it crosses the pixel (not a quadrature's business).
+  return sum + m.line_in_square(q, x - 0.5 * pixel, x + 0.5 * pixel, y - 0.5 * pixel,
+                                y + 0.5 * pixel, tx, ty);
 }
 
 /// One sample's model value (before fresnel_factor): a radial bin (annulus, or a pixel footprint

@@ -50,7 +50,8 @@ void wedges_to_points(std::vector<double>& f, int P, int J) {
 
 bool ObliqueProfile::has_slice(const TransportTable& table, double eta, double g,
                                double incidence_deg) {
-  return !table.partial && table.grid.phi_bins > 1 && find_slice(table, eta, g, incidence_deg);
+  return !table.partial && table.grid.phi_bins > 1 && table.single_scattering_line_excluded &&
+         find_slice(table, eta, g, incidence_deg);
 }
 
 ObliqueProfile::ObliqueProfile(const TransportTable& table, double eta, double g,
@@ -59,6 +60,9 @@ ObliqueProfile::ObliqueProfile(const TransportTable& table, double eta, double g
   if (table.grid.phi_bins < 2)
     throw Error(table.source + ": not an oblique table (no azimuth wedges; build one with "
                 "lucent tabulate --incidence-deg)");
+  if (!table.single_scattering_line_excluded)
+    throw Error(table.source + ": an oblique table from an older lucent (its radiance holds the "
+                "beam's single-scattering line): rebuild it with lucent tabulate --incidence-deg");
   const TransportTableSlice* s = find_slice(table, eta, g, incidence_deg);
   if (!s) {
     std::ostringstream m;

@@ -304,6 +304,8 @@ void write_transport_table(const TransportTable& t, const std::filesystem::path&
       {"payload_bytes", payload.size()},
       {"crc32", crc32(0L, reinterpret_cast<const Bytef*>(payload.data()), uInt(payload.size()))}};
   if (t.partial) h["shard"] = t.shard, h["partial_groups"] = groups;
+  if (t.single_scattering_line_excluded)
+    h["radiance_single_scattering"] = "excluded: the beam's line y = 0, added in closed form";
   write_file_atomically(path, h.dump() + "\n" + payload, /*binary=*/true);
 }
 
@@ -379,6 +381,7 @@ TransportTable read_transport_table_unchecked(const std::filesystem::path& path)
     t.max_path = field("max_path").get<double>();
     t.generator = field("generator").get<std::string>();
     t.partial = field("kind").get<std::string>() == "partial";
+    t.single_scattering_line_excluded = h.contains("radiance_single_scattering");
     for (const json& s : field("slices"))
       t.slice_axes.push_back({s.at("eta").get<double>(), s.at("g").get<double>(),
                               double(whole_number<std::uint64_t>(s.at("photons"), src, "photons")),
@@ -464,6 +467,9 @@ TransportTable merge_transport_tables(const std::vector<TransportTable>& parts) 
   const TransportTable* first_partial = nullptr;
   std::vector<TransportTableGroup> groups;
   for (const TransportTable& p : parts) {
+    if (p.single_scattering_line_excluded != parts.front().single_scattering_line_excluded)
+      throw Error(p.source + ": built by another lucent than " + parts.front().source +
+                  " (radiance_single_scattering differs): rebuild one of them");
     if (!(p.grid == parts.front().grid) || p.groups != parts.front().groups)
       throw Error(p.source + ": grid or groups differ from " + parts.front().source +
                   "'s: tables of different grids cannot be merged");

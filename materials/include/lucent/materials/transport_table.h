@@ -105,6 +105,9 @@ struct TransportTable {
   /// Slice axes (eta, g, photons per slice, incidence in degrees), the slices' order.
   std::vector<std::array<double, 4>> slice_axes;
   std::string source;  ///< where it was read from
+  /// An oblique table's radiance leaves out the beam's single scattering (a line on the surface,
+  /// added in closed form by ObliqueModel). Tables that include it are refused as oblique ones.
+  bool single_scattering_line_excluded = false;
 };
 
 /// Reads a table (finished or partial). Throws lucent::Error naming the file and the field.
