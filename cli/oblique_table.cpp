@@ -85,7 +85,15 @@ std::optional<materials::TransportTable> oblique_table_for(
   if (!cached.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
-    if (!ec) materials::write_transport_table(t, cached);
+    // Kept at once (the fit's own outputs are still to come): a fit that fails later must not
+    // cost the next one this build. A cache that cannot be written is only a warning.
+    try {
+      if (ec) throw Error(dir.string() + ": " + ec.message());
+      materials::write_transport_table(t, cached);
+      commit_pending_outputs();
+    } catch (const Error& e) {
+      warn(std::string("lucent fit: warning: the oblique table is not kept (") + e.what() + ")");
+    }
   }
   t.source = cached.empty() ? std::string("(built for this fit)") : cached.string();
   return t;

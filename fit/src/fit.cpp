@@ -36,9 +36,11 @@ std::string model_name(FitModel m) {
 FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& options) {
   // Ceres logs (through glog) a warning with every residual of a rejected trial step that went
   // non-finite; the solver handles those steps itself, and a user should see our one-line errors
-  // only. Errors still get through.
+  // only.
   static const bool quiet = [] {
-    FLAGS_minloglevel = google::GLOG_ERROR;
+    // Fatal only: an evaluation that fails outright comes back as a failed solve (fit_solve.cpp)
+    // that the restarts replace, and is named in the result when nothing replaces it.
+    FLAGS_minloglevel = google::GLOG_FATAL;
     FLAGS_logtostderr = true;
     return true;
   }();
@@ -169,7 +171,11 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
     for (int c = 0; c < 3; ++c) {
       const double mfp = 1.0 / (st[c].sigma_a + st[c].sigma_s_reduced);
       e[c] = options.exclude_radius_mm ? *options.exclude_radius_mm
-             : m == FitModel::kTabulated ? std::max(2 * pixel_mm, 0.1 * mfp)
+             // 0.1 mean free path, but never past 4 pixels: the start values' mean free path can
+             // be far off (a near-black channel at 60 degrees had 32 mm, and at 2.5 mm its fit
+             // lost the near field it needs), and the model is exact close in.
+             : m == FitModel::kTabulated
+                 ? std::max(2 * pixel_mm, pixel_mm > 0 ? std::min(0.1 * mfp, 4 * pixel_mm) : 0.1 * mfp)
                                          : mfp;
     }
     return e;
@@ -250,12 +256,30 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
     result.candidates.push_back(fit_model(m, start));
   } else if (tab_ok && options.model != FitModel::kDirectionalDipole) {
     // The accurate model, started from the standard dipole's solution (cheap, and in the valley).
-    const ModelFit dipole = fit_model(FitModel::kDipole, start);
-    ModelFit accurate = fit_model(FitModel::kTabulated, started_from(dipole));
+    // A dipole that cannot be fitted at all (its exclusion of one mean free path leaves a
+    // near-black channel nothing) is no reason to fail the accurate fit: in auto mode it is left
+    // out, with a note, and the tabulated fit starts from the data.
+    std::optional<ModelFit> dipole;
+    std::string dipole_problem;
+    try {
+      dipole = fit_model(FitModel::kDipole, start);
+    } catch (const Error& e) {
+      if (options.model == FitModel::kDipole) throw;
+      dipole_problem = e.what();
+    }
+    ModelFit accurate = fit_model(FitModel::kTabulated, dipole ? started_from(*dipole) : start);
     result.candidates.push_back(accurate);
-    if (options.model != FitModel::kTabulated) result.candidates.push_back(dipole);
-    if (options.model == FitModel::kAuto)
-      result.candidates.push_back(fit_model(FitModel::kDirectionalDipole, start));
+    if (dipole && options.model != FitModel::kTabulated) result.candidates.push_back(*dipole);
+    if (options.model == FitModel::kAuto) {
+      try {
+        result.candidates.push_back(fit_model(FitModel::kDirectionalDipole, start));
+      } catch (const Error& e) {
+        if (dipole_problem.empty()) dipole_problem = e.what();
+      }
+    }
+    if (!dipole_problem.empty())
+      result.notes.push_back("the diffusion models could not be fitted to these data (" +
+                             dipole_problem + "); only the tabulated model was");
     if (options.model == FitModel::kDipole) std::swap(result.candidates[0], result.candidates[1]);
   } else if (tab_ok) {  // ddipole requested: the tabulated fit gives its systematic
     result.candidates.push_back(fit_model(FitModel::kDirectionalDipole, start));

@@ -129,7 +129,8 @@ materials::Material fitted_material(const FitResult& result, const std::vector<P
       {"correlation_sigma_a_sigma_s_reduced", corr},
       {"kind",
        "one standard deviation, mm^-1: total = statistical (Jacobian at the solution, "
-       "calibration prior included, scaled by sqrt(reduced chi^2) when above 1) and systematic "
+       "calibration prior included, scaled by the root of the reduced chi^2 or, for pixels, the design effect, when above 1) and "
+       "systematic "
        "(the model's own error: a diffusion model's difference from the tabulated model on the "
        "same data) in quadrature"}};
   if (options.fit_ior) m.uncertainty["ior"] = f.sd_eta;

@@ -556,7 +556,25 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
   eo.parameter_blocks = blocks;
   ceres::CRSMatrix crs;
   std::vector<double> residuals;  // in residual-block order, for the per-channel statistics below
-  problem.Evaluate(eo, nullptr, &residuals, nullptr, &crs);
+  if (summary.termination_type == ceres::FAILURE ||
+      !problem.Evaluate(eo, nullptr, &residuals, nullptr, &crs) || crs.num_rows == 0) {
+    // The model could not be evaluated (a non-finite residual at these start values): a fit that
+    // failed, which the callers' restarts replace (its cost is infinite), never a covariance of
+    // nothing.
+    fit.converged = false;
+    fit.message = "the model could not be evaluated from these start values (" +
+                  summary.message + ")";
+    fit.chi2 = INFINITY;
+    fit.eta = p.eta;
+    for (int c = 0; c < 3; ++c) {
+      ChannelFit& ch = fit.channels[c];
+      ch.sigma_a = start[c].sigma_a, ch.sigma_s_reduced = start[c].sigma_s_reduced;
+      ch.start_sigma_a = start[c].sigma_a, ch.start_sigma_s_reduced = start[c].sigma_s_reduced;
+      ch.residual_rms = ch.robust_residual_rms = ch.reduced_chi2 = INFINITY;
+      ch.samples = samples[c];
+    }
+    return fit;
+  }
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
   for (int row = 0; row < crs.num_rows; ++row) {
     for (int k = crs.rows[row]; k < crs.rows[row + 1]; ++k) J(row, crs.cols[k]) = crs.values[k];

@@ -161,3 +161,56 @@ INSTANTIATE_TEST_SUITE_P(
 
 }  // namespace
 }  // namespace lucent::testing
+
+namespace lucent::testing {
+namespace {
+
+// An oblique capture whose slice the shipped table lacks (skin1, eta 1.3, 30 degrees): lucent fit
+// builds it, keeps it in the cache and reuses it. The slice is built with 5e4 photons to keep the
+// test short; its Monte Carlo noise then dominates the error (measured 3.8% and 1.8 total SD at
+// worst; at the default 1e6 photons within 0.3%), so the bounds are 8% and 3 SD.
+TEST(FitObliqueCapture, BuildsTheMissingSliceOnceAndFitsWithIt) {
+  const fs::path dir = scratch_dir("fit-oblique-cache");
+  const fs::path cache = dir / "cache";
+  ASSERT_EQ(::setenv("LUCENT_CACHE_DIR", cache.c_str(), 1), 0);
+  const auto q = [](const fs::path& p) { return "\"" + p.string() + "\""; };
+  ASSERT_EQ(run_lucent("simulate --material skin1 -o " + q(dir / "sim") +
+                       " --photons 300000 --size 48 --pixel-mm 0.25 --incidence-deg 30 --seed 4")
+                .exit_code,
+            0);
+  ASSERT_EQ(run_lucent("acquire " + q(dir / "sim" / "capture.json") + " -o " + q(dir / "acq"))
+                .exit_code,
+            0);
+  const std::string fit = "fit " + q(dir / "acq" / "profile.json") + " --oblique-photons 50000 --quality fast -o ";
+  const auto first = run_lucent(fit + q(dir / "m1.json"));
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  EXPECT_NE(first.err.find("building the oblique transport table for eta 1.3, g 0, incidence 30"),
+            std::string::npos)
+      << first.err;
+  EXPECT_TRUE(fs::exists(cache / "oblique2-eta1.3-g0-inc30-n50000.lut"));
+  const auto second = run_lucent(fit + q(dir / "m2.json"));
+  ASSERT_EQ(second.exit_code, 0) << second.err;
+  EXPECT_EQ(second.err.find("building"), std::string::npos) << second.err;
+  const nlohmann::json truth =
+      nlohmann::json::parse(read_text(dir / "sim" / "truth.json"))["material"];
+  const nlohmann::json m = nlohmann::json::parse(read_text(dir / "m1.json"));
+  const nlohmann::json m2 = nlohmann::json::parse(read_text(dir / "m2.json"));
+  EXPECT_EQ(m["sigma_a"], m2["sigma_a"]);  // the same slice, read back
+  EXPECT_EQ(m["sigma_s_reduced"], m2["sigma_s_reduced"]);
+  EXPECT_EQ(m["model"], "tabulated");
+  for (int ch = 0; ch < 3; ++ch)
+    for (const char* key : {"sigma_a", "sigma_s_reduced"}) {
+      const double t = truth[key][ch], v = m[key][ch], sd = m["uncertainty"][key][ch];
+      EXPECT_LT(std::abs(v / t - 1), 0.08) << key << "[" << ch << "]";
+      EXPECT_LT(std::abs(v - t), 3 * sd) << key << "[" << ch << "] " << v << " +- " << sd;
+    }
+  // --oblique-table none: the corrected directional dipole, no table built or read.
+  const auto none = run_lucent(fit + q(dir / "m3.json") + " --oblique-table none");
+  ASSERT_EQ(none.exit_code, 0) << none.err;
+  EXPECT_EQ(none.err.find("building"), std::string::npos);
+  ::unsetenv("LUCENT_CACHE_DIR");
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace lucent::testing
