@@ -46,7 +46,7 @@ fit::FitOptions to_options(const FitArguments& a) {
     o.model = fit::FitModel::kAuto;
   else
     throw Error("--model: expected auto, tabulated, dipole or ddipole, got '" + a.model + "'");
-  if (!(a.g >= 0 && a.g <= 0.95)) throw Error("--g: expected a Henyey-Greenstein g in [0, 0.95]");
+  if (!(a.g >= 0 && a.g <= 0.99)) throw Error("--g: expected a Henyey-Greenstein g in [0, 0.99]");
   o.g = a.g;
   if (a.quality == "fast")
     o.quality = fit::Quality::kFast;
@@ -182,7 +182,7 @@ void register_fit_command(CLI::App& app) {
   cmd->add_option("--g", args->g,
                   "Henyey-Greenstein g the tabulated model assumes (radial data cannot tell g "
                   "from sigma_s; the report says how far the answer moves)")
-      ->check(number_in(0, 0.95, "(Henyey-Greenstein g)"))
+      ->check(number_in(0, 0.99, "(Henyey-Greenstein g)"))
       ->capture_default_str();
   cmd->add_option("--table", args->table,
                   "transport table for the tabulated model (default: the shipped one)");

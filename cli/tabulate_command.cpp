@@ -129,7 +129,7 @@ void register_tabulate_command(CLI::App& app) {
   cmd->add_option("-o,--output", args->output, "table file to write (atomically)")->required();
   cmd->add_option("--eta", args->eta, "relative indices, increasing, in [1, 2.5]")
       ->capture_default_str();
-  cmd->add_option("--g", args->g, "Henyey-Greenstein g values, increasing, in [0, 0.95]")
+  cmd->add_option("--g", args->g, "Henyey-Greenstein g values, increasing, in [0, 0.99]")
       ->capture_default_str();
   cmd->add_option("--incidence-deg", args->incidence,
                   "beam angles from the normal (degrees, increasing, in [0, 85]); any > 0 builds "
@@ -140,6 +140,9 @@ void register_tabulate_command(CLI::App& app) {
                   "azimuth wedges over [0, pi] (default: 1, or 12 for an oblique table)")
       ->check(CLI::Range(1, 360));
   cmd->add_option("--photons", o.photons, "photons per slice")->capture_default_str();
+  cmd->add_option("--white-photons", o.white_photons,
+                  "photons of the white run (alpha' >= 0.4) per slice, fewer than --photons to "
+                  "make high-g slices affordable (default: --photons)");
   cmd->add_option("--seed", o.seed, "random seed (same table for any --threads or sharding)")
       ->check(seed_value())
       ->capture_default_str();

@@ -142,7 +142,7 @@ void walk_photon(const Walk& m, Xoshiro256StarStar& rng, double max_path, Escape
 // (absorbing) run for each node below it.
 void trace_group(const SliceConstants& s, const std::vector<AlbedoNode>& nodes,
                  const materials::TransportTableGrid& grid, double max_path,
-                 std::uint64_t photons, Xoshiro256StarStar& rng,
+                 std::uint64_t photons, std::uint64_t white_photons, Xoshiro256StarStar& rng,
                  materials::TransportTableGroup& out, std::atomic<std::uint64_t>& done) {
   const int J = grid.rho_bins();
   const int P = grid.phi_bins;
@@ -183,7 +183,8 @@ void trace_group(const SliceConstants& s, const std::vector<AlbedoNode>& nodes,
     }
   };
   const Walk white{s.sigma_s, 1.0, &s};
-  for (std::uint64_t n = 0; n < photons; ++n) {
+  if (white_nodes == 0) white_photons = 0;
+  for (std::uint64_t n = 0; n < white_photons; ++n) {
     walk_photon(
         white, rng, max_path,
         [&](double x, double y, double path, double) {
@@ -200,7 +201,7 @@ void trace_group(const SliceConstants& s, const std::vector<AlbedoNode>& nodes,
         });
     if ((n & 1023) == 1023) done.fetch_add(1024, std::memory_order_relaxed);
   }
-  done.fetch_add(photons & 1023, std::memory_order_relaxed);
+  done.fetch_add(white_photons & 1023, std::memory_order_relaxed);
 
   // Direct runs: the absorbing medium itself, sigma_t' = 1, binned as it is.
   for (std::size_t k = white_nodes; k < K; ++k) {
@@ -234,15 +235,17 @@ void trace_group(const SliceConstants& s, const std::vector<AlbedoNode>& nodes,
 
   // Means per photon, per unit area of the real medium's annuli (or wedges of them, both sides
   // of y = 0: 1 / P of the annulus); pi L for the radiance.
+  const auto traced = [&](std::size_t k) { return double(k < white_nodes ? white_photons : photons); };
   for (std::size_t row = 0; row < grid.rows(); ++row) {
+    const double n = traced(row / std::size_t(P));
     for (int j = 0; j < J; ++j) {
       const double r0 = grid.rho_edge(j), r1 = grid.rho_edge(j + 1);
       const double area = std::numbers::pi * (r1 * r1 - r0 * r0) / P;
-      exitance[row * std::size_t(J) + std::size_t(j)] /= double(photons) * area;
-      radiance[row * std::size_t(J) + std::size_t(j)] *= std::numbers::pi / (double(photons) * area);
+      exitance[row * std::size_t(J) + std::size_t(j)] /= n * area;
+      radiance[row * std::size_t(J) + std::size_t(j)] *= std::numbers::pi / (n * area);
     }
   }
-  for (std::size_t k = 0; k < K; ++k) out.total[k] /= double(photons);
+  for (std::size_t k = 0; k < K; ++k) out.total[k] /= traced(k);
 }
 
 }  // namespace
@@ -263,7 +266,7 @@ void validate_tabulate_options(const TabulateOptions& o) {
   if (o.grid.phi_bins == 1 && (o.incidence_deg.size() > 1 || o.incidence_deg[0] != 0))
     bad("--phi-bins: an oblique table needs azimuth wedges (e.g. 12)");
   for (double g : o.g)
-    if (!(g >= 0.0 && g <= 0.95)) bad("--g: each Henyey-Greenstein g must be in [0, 0.95]");
+    if (!(g >= 0.0 && g <= 0.99)) bad("--g: each Henyey-Greenstein g must be in [0, 0.99]");
   for (std::size_t i = 1; i < o.eta.size(); ++i)
     if (!(o.eta[i] > o.eta[i - 1])) bad("--eta: the indices must be strictly increasing");
   for (std::size_t i = 1; i < o.g.size(); ++i)
@@ -277,6 +280,9 @@ void validate_tabulate_options(const TabulateOptions& o) {
   if (o.groups < 2 || o.groups > 1024) bad("--groups: expected 2..1024 photon groups");
   if (o.photons < std::uint64_t(o.groups) || o.photons > 1'000'000'000'000ULL)
     bad("--photons: expected at least one photon per group and at most 1e12");
+  if (o.white_photons != 0 &&
+      (o.white_photons < std::uint64_t(o.groups) || o.white_photons > o.photons))
+    bad("--white-photons: expected at least one photon per group and at most --photons");
   if (o.threads < 0 || o.threads > 1024) bad("--threads: expected 0 (all cores) to 1024");
   if (!(o.max_path >= 10 && o.max_path <= 1e9)) bad("--max-path: expected 10..1e9");
   if (o.shard_count < 1 || o.shard_index < 0 || o.shard_index >= o.shard_count)
@@ -295,6 +301,9 @@ materials::TransportTable tabulate_transport(const TabulateOptions& o,
   for (double a : o.incidence_deg)
     if (a != 0) table.single_scattering_line_excluded = true;
   const std::uint64_t per_group = (o.photons + std::uint64_t(o.groups) - 1) / std::uint64_t(o.groups);
+  const std::uint64_t white_per_group =
+      o.white_photons > 0 ? (o.white_photons + std::uint64_t(o.groups) - 1) / std::uint64_t(o.groups)
+                          : per_group;
 
   std::vector<SliceConstants> slices;
   for (double incidence : o.incidence_deg) {
@@ -311,7 +320,9 @@ materials::TransportTable tabulate_transport(const TabulateOptions& o,
       s.nee_factor = materials::fresnel_transmittance(1.0, s.eta_out) / (eta * eta);
       s.hg = HenyeyGreenstein(g);
       slices.push_back(s);
-      table.slice_axes.push_back({eta, g, double(per_group * std::uint64_t(o.groups)), incidence});
+      table.slice_axes.push_back({eta, g, double(per_group * std::uint64_t(o.groups)), incidence,
+                                  o.white_photons > 0 ? double(white_per_group * std::uint64_t(o.groups))
+                                                      : 0.0});
     }
   }
   }
@@ -332,7 +343,8 @@ materials::TransportTable tabulate_transport(const TabulateOptions& o,
     for (int g = 0; g < o.groups; ++g)
       if ((s * o.groups + g) % o.shard_count == o.shard_index) units.emplace_back(s, g);
   std::vector<materials::TransportTableGroup> results(units.size());
-  const std::uint64_t total = per_group * units.size();
+  // Progress counts the white run's photons (the direct runs' are short).
+  const std::uint64_t total = white_per_group * units.size();
 
   std::atomic<std::uint64_t> done{0};
   std::atomic<std::size_t> next{0};
@@ -349,7 +361,8 @@ materials::TransportTable tabulate_transport(const TabulateOptions& o,
             slice_seed(o.seed, slices[s].eta, slices[s].g, slices[s].incidence, g));
         results[i].slice = s;
         results[i].group = g;
-        trace_group(slices[s], nodes, o.grid, o.max_path, per_group, rng, results[i], done);
+        trace_group(slices[s], nodes, o.grid, o.max_path, per_group, white_per_group, rng,
+                    results[i], done);
       } catch (...) {
         std::lock_guard lock(error_mutex);
         if (!error) error = std::current_exception();

@@ -74,9 +74,11 @@ json grid_json(const TransportTableGrid& g) {
           {"phi_bins", g.phi_bins}};
 }
 
-json slice_json(double eta, double g, std::uint64_t photons, double incidence_deg) {
+json slice_json(double eta, double g, std::uint64_t photons, double incidence_deg,
+                std::uint64_t white_photons) {
   json s = {{"eta", eta}, {"g", g}, {"photons", photons}};
   if (incidence_deg != 0) s["incidence_deg"] = incidence_deg;
+  if (white_photons != 0 && white_photons != photons) s["white_photons"] = white_photons;
   return s;
 }
 
@@ -203,6 +205,7 @@ void finish_transport_table(TransportTable& table, const std::vector<TransportTa
     slice.g = table.slice_axes[s][1];
     slice.photons = std::uint64_t(table.slice_axes[s][2]);
     slice.incidence_deg = table.slice_axes[s][3];
+    slice.white_photons = std::uint64_t(table.slice_axes[s][4]);
     for (int q = 0; q < kTableQuantities; ++q) {
       std::vector<double> mean(n, 0.0), rel(n, 0.0);
       for (std::size_t e = 0; e < n; ++e) {
@@ -253,7 +256,7 @@ void write_transport_table(const TransportTable& t, const std::filesystem::path&
   json slices = json::array();
   if (!t.partial) {
     for (const TransportTableSlice& s : t.slices) {
-      slices.push_back(slice_json(s.eta, s.g, s.photons, s.incidence_deg));
+      slices.push_back(slice_json(s.eta, s.g, s.photons, s.incidence_deg, s.white_photons));
       for (int q = 0; q < kTableQuantities; ++q) {
         put(payload, s.value[std::size_t(q)].data(), n);
         put(payload, s.se_code[std::size_t(q)].data(), n);
@@ -263,7 +266,7 @@ void write_transport_table(const TransportTable& t, const std::filesystem::path&
     }
   } else {
     for (const auto& a : t.slice_axes)
-      slices.push_back(slice_json(a[0], a[1], std::uint64_t(a[2]), a[3]));
+      slices.push_back(slice_json(a[0], a[1], std::uint64_t(a[2]), a[3], std::uint64_t(a[4])));
   }
   json groups = json::array();
   for (const TransportTableGroup& g : t.partial_groups) {
@@ -385,7 +388,11 @@ TransportTable read_transport_table_unchecked(const std::filesystem::path& path)
     for (const json& s : field("slices"))
       t.slice_axes.push_back({s.at("eta").get<double>(), s.at("g").get<double>(),
                               double(whole_number<std::uint64_t>(s.at("photons"), src, "photons")),
-                              s.value("incidence_deg", 0.0)});
+                              s.value("incidence_deg", 0.0),
+                              s.contains("white_photons")
+                                  ? double(whole_number<std::uint64_t>(s.at("white_photons"), src,
+                                                                       "white_photons"))
+                                  : 0.0});
   } catch (const json::exception& e) {
     throw Error(src + ": grid, slices or groups: unexpected value (" + std::string(e.what()) + ")");
   }
@@ -420,6 +427,7 @@ TransportTable read_transport_table_unchecked(const std::filesystem::path& path)
     for (const auto& a : t.slice_axes) {
       TransportTableSlice s;
       s.eta = a[0], s.g = a[1], s.photons = std::uint64_t(a[2]), s.incidence_deg = a[3];
+      s.white_photons = std::uint64_t(a[4]);
       for (int q = 0; q < kTableQuantities; ++q) {
         s.value[std::size_t(q)].resize(n);
         s.se_code[std::size_t(q)].resize(n);
@@ -505,7 +513,8 @@ TransportTable merge_transport_tables(const std::vector<TransportTable>& parts) 
                   " is given twice");
   out.slice_axes.clear();
   for (const auto& s : out.slices)
-    out.slice_axes.push_back({s.eta, s.g, double(s.photons), s.incidence_deg});
+    out.slice_axes.push_back(
+        {s.eta, s.g, double(s.photons), s.incidence_deg, double(s.white_photons)});
   out.partial = false;
   out.shard.clear();
   out.source.clear();

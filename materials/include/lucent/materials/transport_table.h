@@ -74,6 +74,7 @@ struct TransportTableSlice {
   double eta = 1;
   double g = 0;
   double incidence_deg = 0;  ///< the beam's angle from the normal, outside the medium
+  std::uint64_t white_photons = 0;  ///< behind the white nodes (alpha' >= 0.4); 0: `photons`
   std::uint64_t photons = 0;  ///< photons behind every entry of the slice
   /// [quantity][row * rho_bins + j] (rows as TransportTableGrid::rows()): bin-average value and
   /// standard-error code.
@@ -102,8 +103,9 @@ struct TransportTable {
   bool partial = false;                     ///< a shard: groups instead of slices
   std::string shard;                        ///< "I/N" for a shard
   std::vector<TransportTableGroup> partial_groups;
-  /// Slice axes (eta, g, photons per slice, incidence in degrees), the slices' order.
-  std::vector<std::array<double, 4>> slice_axes;
+  /// Slice axes (eta, g, photons per slice, incidence in degrees, white-run photons or 0 for the
+  /// same), the slices' order.
+  std::vector<std::array<double, 5>> slice_axes;
   std::string source;  ///< where it was read from
   /// An oblique table's radiance leaves out the beam's single scattering (a line on the surface,
   /// added in closed form by ObliqueModel). Tables that include it are refused as oblique ones.
