@@ -6,6 +6,7 @@ exitance, >= 1e6 photons per channel), then `lucent fit` with the default model 
 and with --model dipole / ddipole, reading the CSV unchanged. Writes fit_vs_montecarlo.md: per
 channel, the error of both coefficients against the material, the z-score (error over the reported
 total SD) and the fit's time. Usage: fit_vs_montecarlo.py LUCENT [PHOTONS] [MATERIALS...]
+($LUCENT_FVMC_OUT: another output file, for a subset.)
 """
 import json
 import os
@@ -111,7 +112,7 @@ for name, path, m, gfit in material_cases():
                 rows.append((name, rep["chosen"]["model"], (c, key, truth, v, sd, alpha,
                                                            rep["chosen"]["time_ms"]), None))
 
-with open(os.path.join(root, "fit_vs_montecarlo.md"), "w") as f:
+with open(os.environ.get("LUCENT_FVMC_OUT", os.path.join(root, "fit_vs_montecarlo.md")), "w") as f:
     f.write("# Fitting Monte Carlo truth\n\n")
     f.write(f"Made by `notebooks_data/bench/fit_vs_montecarlo.py` ({photons} photons per channel, "
             "seed 3, semi-infinite slab, normal incidence): the simulator's radial exitance CSV "

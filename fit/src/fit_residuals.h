@@ -1,0 +1,211 @@
+// The residuals of a fit (DESIGN §6): what one residual block measures (a run of radial bins or
+// single pixels of one channel of one capture) and the Ceres cost functions over it, for every
+// model. Internal to lucent_fit (fit_solve.cpp builds the problem from these).
+#pragma once
+
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <vector>
+
+#include "dipole_gradient.h"
+#include "fit_solve.h"
+#include "lucent/fit/fit.h"
+#include "lucent/materials/tabulated.h"
+#include "model_prediction.h"
+
+namespace lucent::fit::detail {
+
+constexpr double kDegree = std::numbers::pi / 180.0;
+
+inline CaptureGeometry geometry_of(const ProfileData& d) {
+  CaptureGeometry g;
+  const double theta = d.incidence_polar_deg * kDegree, phi = d.incidence_azimuth_deg * kDegree;
+  g.cos_incidence = std::cos(theta);
+  g.cos_view = std::cos(d.view_deg * kDegree);
+  // The beam travels toward azimuth phi, so the light sits the other way.
+  g.w_i = {-std::sin(theta) * std::cos(phi), -std::sin(theta) * std::sin(phi), std::cos(theta)};
+  g.exitance = d.exitance;
+  g.per_incident_power = d.per_incident_power;
+  return g;
+}
+
+// What one residual block measures: a run of radial bins or 2D samples of one channel of one
+// capture.
+struct Observations {
+  bool radial = true;
+  CaptureGeometry geometry;
+  std::vector<double> r, r0, r1;   // radial
+  std::vector<double> x, y;        // 2D
+  double pixel = 0;                // footprint side of the pixels behind the samples, mm
+  std::vector<double> log_value;   // log of the measurement
+  std::vector<double> inv_rel_se;  // value / standard error: weights the log-ratio
+  std::vector<double> data_rel_se;  // the data's own relative standard error (before the table's)
+  // Single pixels (2D samples) are fitted in linear form, (model - value) / se: at their per-pixel
+  // noise (10-40% in a faint tail) a log-ratio is biased (E log v < log E v) and a noise-floor cut
+  // selects upward fluctuations; every pixel is kept, negative ones too. Then `value` and
+  // `inv_se` are used, log_value holds log(max(value, se)) (sizes and plots only).
+  bool linear = false;
+  std::vector<double> value, inv_se, data_se;
+  int capture = 0;  // index of the profile these come from
+};
+
+// Residuals (log model - log data) * value / se: the log-ratio in units of the relative standard
+// error. Parameters: {log sigma_a, log sigma_s'}, {log scale}, {eta}.
+struct ProfileResiduals {
+  const Observations* obs;
+  FitModel model;
+  GaussLegendre gl;
+  const materials::TabulatedProfile* table = nullptr;  // kTabulated only
+  ModelPerturbation perturbation{};
+
+  template <typename T>
+  bool operator()(const T* const ab, const T* const log_scale, const T* const eta,
+                  T* residual) const {
+    return evaluate(ab, log_scale[0], eta[0], residual);
+  }
+
+  template <typename T>
+  bool evaluate(const T* const ab, const T& log_scale, const T& eta, T* residual) const {
+    using std::exp;
+    using std::log;
+    const materials::Medium<T> medium =
+        materials::Medium<T>::from_reduced(exp(ab[0]), exp(ab[1]), eta);
+    const T log_front = log_scale + log(detail::fresnel_factor(obs->geometry, eta, model));
+    const std::size_t n = obs->log_value.size();
+    // The tabulated model is built once per evaluation (its rows at these coefficients), then
+    // read at every sample.
+    std::optional<materials::TabulatedModel<T>> tab;
+    std::optional<materials::DirectionalDipole<T>> dd;  // oblique 2D data: the corrected ddipole
+    std::optional<materials::ObliqueModel<T>> ob;  // or the oblique table, where there is one
+    const bool oblique = !obs->radial && obs->geometry.cos_incidence < 0.9999;
+    if (model == FitModel::kTabulated) {
+      if (oblique && table->oblique())
+        ob.emplace(*table->oblique(), medium);
+      else
+        tab.emplace(*table, medium);
+    }
+    if (tab && oblique) dd.emplace(medium);
+    const materials::TableQuantity q = detail::table_quantity(obs->geometry);
+    for (std::size_t i = 0; i < n; ++i) {
+      const T v =
+          ob ? detail::oblique_pixel(*ob, q, obs->geometry, obs->x[i], obs->y[i], obs->pixel, gl)
+          : tab ? (obs->radial  ? detail::tabulated_annulus(*tab, q, obs->r[i], obs->r0[i], obs->r1[i], gl)
+                 : oblique ? detail::corrected_ddipole_pixel(*tab, *dd, q, obs->geometry, obs->x[i],
+                                                             obs->y[i], obs->pixel, gl)
+                           : detail::tabulated_pixel(*tab, q, obs->x[i], obs->y[i], obs->pixel, gl))
+              : detail::model_value(model, table, medium, obs->geometry, obs->radial,
+                                    obs->radial ? obs->r[i] : 0.0, obs->radial ? obs->r0[i] : 0.0,
+                                    obs->radial ? obs->r1[i] : 0.0, obs->x[i], obs->y[i],
+                                    obs->pixel, gl);
+      T scaled = v;
+      if (perturbation.epsilon != 0) {
+        const double r = obs->radial ? obs->r[i] : std::hypot(obs->x[i], obs->y[i]);
+        scaled *= perturbation.factor(T(r) * (medium.sigma_a + medium.sigma_s));
+      }
+      if (obs->linear)
+        residual[i] = (exp(log_front) * scaled - obs->value[i]) * obs->inv_se[i];
+      else
+        residual[i] = (log_front + log(scaled + T(1e-300)) - obs->log_value[i]) * obs->inv_rel_se[i];
+    }
+    return true;
+  }
+};
+
+// The common case, scale and eta held: derivatives in the two channel parameters only (Jets of 2,
+// not 4: half the work).
+struct ChannelResiduals {
+  ProfileResiduals full;
+  const double* log_scale;
+  const double* eta;
+
+  template <typename T>
+  bool operator()(const T* const ab, T* residual) const {
+    return full.evaluate(ab, T(*log_scale), T(*eta), residual);
+  }
+};
+
+// The standard dipole with a hand-written Jacobian (scale and eta held): annuli, or pixel
+// footprints.
+class DipoleRadialCost : public ceres::CostFunction {
+ public:
+  // Parameter blocks: {log sigma_a, log sigma_s'} and {log scale}.
+  DipoleRadialCost(const Observations* obs, GaussLegendre gl, const double* eta)
+      : obs_(obs), gl_(gl), eta_(eta) {
+    set_num_residuals(int(obs->log_value.size()));
+    mutable_parameter_block_sizes()->push_back(2);
+    mutable_parameter_block_sizes()->push_back(1);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const double* ab = parameters[0];
+    const detail::DipoleGradientModel model(std::exp(ab[0]), std::exp(ab[1]), *eta_);
+    const double log_front =
+        parameters[1][0] +
+        std::log(detail::fresnel_factor(obs_->geometry, *eta_, FitModel::kDipole));
+    for (std::size_t i = 0; i < obs_->log_value.size(); ++i) {
+      detail::DipoleGradient sum;
+      const auto add = [&](double weight, double r) {
+        const detail::DipoleGradient g = model.at(r);
+        sum.value += weight * g.value;
+        sum.d_log_sigma_a += weight * g.d_log_sigma_a;
+        sum.d_log_sigma_s += weight * g.d_log_sigma_s;
+      };
+      if (!obs_->radial) {  // a pixel footprint (2D sample, or a bin of pixel averages)
+        const double p = obs_->pixel;
+        if (!(p > 0)) {
+          add(1.0, std::hypot(obs_->x[i], obs_->y[i]));
+        } else {
+          for (int a = 0; a < gl_.order; ++a) {
+            for (int b = 0; b < gl_.order; ++b) {
+              add(gl_.weight[a] * gl_.weight[b], std::hypot(obs_->x[i] + (gl_.node[a] - 0.5) * p,
+                                                            obs_->y[i] + (gl_.node[b] - 0.5) * p));
+            }
+          }
+        }
+      } else if (!(obs_->r1[i] > obs_->r0[i])) {
+        add(1.0, obs_->r[i]);
+      } else {
+        const double r0 = obs_->r0[i], r1 = obs_->r1[i];
+        for (int k = 0; k < gl_.order; ++k)
+          add(gl_.weight[k], std::sqrt(r0 * r0 + gl_.node[k] * (r1 * r1 - r0 * r0)));
+      }
+      const double v = sum.value + 1e-300;
+      const double w = obs_->inv_rel_se[i];
+      residuals[i] = (log_front + std::log(v) - obs_->log_value[i]) * w;
+      if (jacobians && jacobians[0]) {
+        jacobians[0][2 * i] = w * sum.d_log_sigma_a / v;
+        jacobians[0][2 * i + 1] = w * sum.d_log_sigma_s / v;
+      }
+      if (jacobians && jacobians[1]) jacobians[1][i] = w;
+    }
+    return true;
+  }
+
+ private:
+  const Observations* obs_;
+  GaussLegendre gl_;
+  const double* eta_;
+};
+
+// Prior on a calibration scale: log scale ~ N(0, relative_se).
+struct ScalePrior {
+  double inverse_se;
+  template <typename T>
+  bool operator()(const T* const log_scale, T* residual) const {
+    residual[0] = log_scale[0] * inverse_se;
+    return true;
+  }
+};
+
+
+/// Usable observations of one channel of one capture, after exclusion and the noise floor.
+Observations observations_for(const ProfileData& d, int c, double exclude_mm, bool use_2d,
+                              const QualitySettings& q, int* below_noise);
+
+}  // namespace lucent::fit::detail
