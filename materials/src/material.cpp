@@ -18,6 +18,7 @@
 #include <system_error>
 
 #include "lucent/materials/atomic_file.h"
+#include "lucent/materials/albedo.h"
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/error.h"
 
@@ -30,10 +31,10 @@ constexpr std::string_view kFormatName = "lucent-material";
 constexpr std::array<std::string_view, 3> kChannelNames = {"R", "G", "B"};
 
 // Every top-level field the format knows, in the order they are written.
-constexpr std::array<std::string_view, 13> kKnownFields = {
+constexpr std::array<std::string_view, 15> kKnownFields = {
     "format",  "version", "name",           "ior",         "sigma_a",    "sigma_s_reduced",
     "sigma_s", "g",       "model",          "adequate_model", "uncertainty", "provenance",
-    "derived"};
+    "derived", "diffuse_colour", "mfp_mm"};
 
 // Agreement required between a given sigma_s' and sigma_s (1 - g): relative, with an absolute floor
 // for channels that (almost) do not scatter, where a relative test would demand exact zeros.
@@ -129,6 +130,10 @@ class MaterialReader {
     Material m;
     m.name = read_name();
     m.ior = read_ior();
+    if (find("diffuse_colour") || find("mfp_mm")) {
+      read_appearance(m);
+      return finish(m);
+    }
     m.sigma_a = read_rgb("sigma_a", "a number in [0, 1e6] (mm^-1)", is_coefficient);
 
     const json* sigma_s = find("sigma_s");
@@ -148,9 +153,15 @@ class MaterialReader {
       for (int c = 0; c < 3; ++c) m.sigma_s_reduced[c] = (*m.sigma_s)[c] * (1.0 - (*m.g)[c]);
     } else {
       fail("sigma_s_reduced",
-           "missing; expected an array of 3 numbers in [0, 1e6] (mm^-1), or 'sigma_s' with 'g'");
+           "missing; expected an array of 3 numbers in [0, 1e6] (mm^-1), or 'sigma_s' with 'g', "
+           "or 'diffuse_colour' with 'mfp_mm'");
     }
+    return finish(m);
+  }
 
+ private:
+  // The fields after the coefficients, whichever way these were given.
+  Material finish(Material& m) {
     if (const json* model = find("model")) {
       if (!model->is_string()) fail("model", "expected a string, found " + describe(*model));
       m.model = model->get<std::string>();
@@ -171,7 +182,30 @@ class MaterialReader {
     return m;
   }
 
- private:
+  // An appearance instead of coefficients (pbrt's reflectance/mfp, Blender's colour and radius):
+  // per channel the standard dipole's total diffuse reflectance in (0, 1) and the diffuse mean
+  // free path 1 / sigma_tr in mm, inverted by coefficients_from_diffuse_colour (Jensen and Buhler
+  // 2002) at the material's index.
+  void read_appearance(Material& m) {
+    for (std::string_view other : {"sigma_a", "sigma_s_reduced", "sigma_s", "g"})
+      if (find(other))
+        fail(other, "given with 'diffuse_colour'/'mfp_mm': give coefficients or an appearance, "
+                    "not both");
+    if (!find("diffuse_colour")) fail("diffuse_colour", "missing; expected together with 'mfp_mm'");
+    if (!find("mfp_mm")) fail("mfp_mm", "missing; expected together with 'diffuse_colour'");
+    const Rgb colour = read_rgb("diffuse_colour", "a total diffuse reflectance in (0, 1)",
+                                [](double x) { return std::isfinite(x) && x > 0 && x < 1; });
+    const Rgb mfp = read_rgb("mfp_mm", "a diffuse mean free path in (0, 1e6] mm",
+                             [](double x) { return std::isfinite(x) && x > 0 && x <= 1e6; });
+    for (int c = 0; c < 3; ++c) {
+      const ReducedCoefficients k = coefficients_from_diffuse_colour(colour[c], mfp[c], m.ior);
+      if (!(is_coefficient(k.sigma_a) && is_coefficient(k.sigma_s_reduced)))
+        fail("mfp_mm", "element " + std::to_string(c) + " gives coefficients beyond 1e6 mm^-1");
+      m.sigma_a[c] = k.sigma_a;
+      m.sigma_s_reduced[c] = k.sigma_s_reduced;
+    }
+  }
+
   // At most 1e6 mm^-1 (a mean free path of a nanometre): beyond it the models' exponentials and
   // products overflow and no optical measurement could tell the difference.
   static bool is_coefficient(double x) {
