@@ -16,5 +16,6 @@ void register_view_command(CLI::App& app);
 void register_tabulate_command(CLI::App& app);
 void register_compare_command(CLI::App& app);
 void register_material_commands(CLI::App& app);
+void register_merge_command(CLI::App& app);
 
 }  // namespace lucent::cli

@@ -4,6 +4,7 @@
 #include <iostream>
 #include <memory>
 
+#include "batch.h"
 #include "commands.h"
 #include "oblique_table.h"
 #include "validators.h"
@@ -29,7 +30,9 @@ struct FitArguments {
   CLI::Option* ior_option = nullptr;
   double ior = 0;
   double g = 0;
-  std::string table, oblique_table;
+  std::string table, oblique_table, batch, shard;
+  bool quiet = false;    // batch rows: no per-row summary on stdout
+  bool row_ior = false;  // a batch row gave ior
   std::uint64_t oblique_photons = 1'000'000;
   bool fit_ior = false, relative = false, json = false, allow_unconverged = false;
 };
@@ -80,7 +83,7 @@ fit::FitOptions to_options(const FitArguments& a) {
   }
   // Given or not is what counts (the validators have checked the values): no value falls back.
   if (a.exclude_option && a.exclude_option->count() > 0) o.exclude_radius_mm = a.exclude_radius_mm;
-  if (a.ior_option && a.ior_option->count() > 0) {
+  if (a.row_ior || (a.ior_option && a.ior_option->count() > 0)) {
     if (!(a.ior > 0 && a.ior <= 4)) throw Error("--ior: expected a relative index in (0, 4]");
     o.ior = a.ior;
   }
@@ -90,7 +93,7 @@ fit::FitOptions to_options(const FitArguments& a) {
   return o;
 }
 
-void run(const FitArguments& a) {
+materials::Material run(const FitArguments& a) {
   fit::FitOptions options = to_options(a);
   // Where the outputs go is checked before the fit (they are written together at the end).
   check_output_file(a.output, ".json", "-o");
@@ -126,11 +129,15 @@ void run(const FitArguments& a) {
   materials::write_material(a.output, material);
 
   const fit::ModelFit& f = result.chosen;
+  if (a.quiet) {
+    for (const std::string& w : result.warnings) warn("lucent fit: " + a.output + ": warning: " + w);
+    return material;
+  }
   if (a.json) {
     nlohmann::json j = fit::fit_report(result, data, options);
     j["output"] = a.output;
     std::cout << j.dump(2) << '\n';
-    return;
+    return material;
   }
   const char* names[3] = {"R", "G", "B"};
   std::cout << "fitted " << fit::to_string(f.model) << " (" << result.reason << ")\n";
@@ -159,6 +166,74 @@ void run(const FitArguments& a) {
   for (const std::string& note : result.notes) std::cout << "  note: " << note << '\n';
   for (const std::string& w : result.warnings) warn("lucent fit: warning: " + w);
   std::cout << "wrote " << a.output << '\n';
+  return material;
+}
+
+// --batch: every manifest row (or this shard's: rows i with i mod N = I) fitted like one `lucent
+// fit` with the row's options over the command line's; a row that fails is recorded, not fatal.
+// -o is the summary (JSON); the exit status is 1 when any row failed.
+void run_batch(const FitArguments& a) {
+  if (!a.inputs.empty()) throw Error("--batch: give the profiles in the manifest, not as arguments");
+  check_output_file(a.output, ".json", "-o");
+  const auto [shard, shards] = a.shard.empty() ? std::pair{0, 1} : parse_shard(a.shard, "--shard");
+  const std::vector<BatchRow> rows = read_batch_manifest(a.batch);
+  std::vector<BatchOutcome> outcomes;
+  int failed = 0;
+  for (const BatchRow& row : rows) {
+    if (int(row.index % std::size_t(shards)) != shard) continue;
+    BatchOutcome o;
+    o.row = row;
+    try {
+      FitArguments r = a;
+      r.inputs = {row.input};
+      r.output = row.output;
+      r.quiet = true;
+      r.json = false;
+      r.plot.clear(), r.report.clear();
+      if (row.options.count("model")) r.model = row.options.at("model");
+      if (row.options.count("name")) r.name = row.options.at("name");
+      const auto number = [&](const char* column) {
+        const std::string& text = row.options.at(column);
+        std::size_t used = 0;
+        double v = 0;
+        try {
+          v = std::stod(text, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used != text.size() || !std::isfinite(v))
+          throw Error(a.batch + ": row " + std::to_string(row.index + 1) + ": column '" + column +
+                      "': expected a number, got '" + text + "'");
+        return v;
+      };
+      if (row.options.count("g")) r.g = number("g");
+      if (row.options.count("ior")) {
+        r.ior = number("ior");
+        r.ior_option = nullptr;
+        r.row_ior = true;
+      }
+      o.material = run(r);
+      o.ok = true;
+    } catch (const std::exception& e) {
+      o.error = e.what();
+      ++failed;
+    }
+    outcomes.push_back(std::move(o));
+  }
+  const nlohmann::json summary =
+      batch_summary(a.batch, rows.size(), outcomes,
+                    shards > 1 ? std::to_string(shard) + "/" + std::to_string(shards) : "");
+  check_finite_json(summary, a.output);
+  write_file_atomically(a.output, summary.dump(2) + "\n");
+  std::cout << "fitted " << outcomes.size() - std::size_t(failed) << " of " << outcomes.size()
+            << " rows" << (shards > 1 ? " (shard " + a.shard + " of " + std::to_string(rows.size()) + ")" : std::string())
+            << "; summary " << a.output << '\n';
+  // The rows that were fitted and the summary are kept (a job array reruns the failed rows from
+  // it); the exit status still says that some failed.
+  commit_pending_outputs();
+  if (failed > 0)
+    throw Error("--batch: " + std::to_string(failed) + " of " + std::to_string(outcomes.size()) +
+                " rows failed (their errors are in " + a.output + ")");
 }
 
 }  // namespace
@@ -173,7 +248,7 @@ void register_fit_command(CLI::App& app) {
                          "to transport (tabulated) for radial normal-incidence data, with which "
                          "cheaper model would do. Several profiles of one material are fitted "
                          "jointly.");
-  cmd->add_option("inputs", args->inputs, "profile files (.json or .csv)")->required();
+  cmd->add_option("inputs", args->inputs, "profile files (.json or .csv)");
   cmd->add_option("-o,--output", args->output, "material file to write (.json)")->required();
   cmd->add_option("--model", args->model,
                   "auto (the accurate model, and which cheaper one is adequate), tabulated, dipole "
@@ -220,7 +295,19 @@ void register_fit_command(CLI::App& app) {
   cmd->add_flag("--allow-unconverged", args->allow_unconverged,
                 "write the best values even when the solver did not converge");
   cmd->add_flag("--json", args->json, "print the report as JSON on stdout");
-  cmd->callback([args] { run(*args); });
+  cmd->add_option("--batch", args->batch,
+                  "fit every row of this manifest (CSV: input, output, and optionally ior, model, "
+                  "g, name per row; paths from the manifest's folder); -o is then the summary "
+                  "(.json)");
+  cmd->add_option("--shard", args->shard,
+                  "with --batch: only rows i with i mod N = I (0-based I/N: a job array's task); "
+                  "lucent merge joins the shards' summaries");
+  cmd->callback([args] {
+    if (!args->batch.empty()) return run_batch(*args);
+    if (!args->shard.empty()) throw Error("--shard: only with --batch");
+    if (args->inputs.empty()) throw Error("inputs: at least one profile file is required");
+    run(*args);
+  });
 }
 
 }  // namespace lucent::cli

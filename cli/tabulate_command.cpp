@@ -6,11 +6,13 @@
 #include <memory>
 #include <sstream>
 
+#include "batch.h"
 #include "commands.h"
 #include "validators.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/acquire/tabulate.h"
 #include "lucent/materials/error.h"
+#include "lucent/materials/json_file.h"
 #include "lucent/materials/profile_table.h"
 
 namespace lucent::cli {
@@ -157,6 +159,35 @@ void register_tabulate_command(CLI::App& app) {
       ->expected(1, -1);
   cmd->add_flag("-q,--quiet", args->quiet, "no progress or summary");
   cmd->callback([args] { run(*args); });
+}
+
+// `lucent merge`: the shards of a job array, put together: transport tables (.lut, as tabulate
+// --merge) or batch-fit summaries (.json, lucent fit --batch --shard).
+void register_merge_command(CLI::App& app) {
+  auto output = std::make_shared<std::string>();
+  auto inputs = std::make_shared<std::vector<std::string>>();
+  CLI::App* cmd = app.add_subcommand(
+      "merge",
+      "Joins the shards of a job array: transport tables (.lut from lucent tabulate --shard) or "
+      "batch summaries (.json from lucent fit --batch --shard). Every shard exactly once; the "
+      "result equals one unsharded run.");
+  cmd->add_option("inputs", *inputs, "the shards")->required()->expected(1, -1);
+  cmd->add_option("-o,--output", *output, "the merged file")->required();
+  cmd->callback([output, inputs] {
+    const bool tables = std::filesystem::path(inputs->front()).extension() == ".lut";
+    check_output_file(*output, tables ? ".lut" : ".json", "-o");
+    if (tables) {
+      std::vector<materials::TransportTable> parts;
+      for (const std::string& p : *inputs) parts.push_back(materials::read_transport_table(p));
+      materials::write_transport_table(materials::merge_transport_tables(parts), *output);
+    } else {
+      std::vector<nlohmann::json> parts;
+      for (const std::string& p : *inputs) parts.push_back(read_json_file(p));
+      const nlohmann::json merged = merge_batch_summaries(parts, *inputs);
+      write_file_atomically(*output, merged.dump(2) + "\n");
+    }
+    std::cout << "merged " << inputs->size() << " shards into " << *output << '\n';
+  });
 }
 
 }  // namespace lucent::cli

@@ -84,8 +84,9 @@ void finish_uncertainty(FitResult& result, const FitOptions& options,
           std::string("channel ") + kNames[c] + ": the usable range " +
           number(ch.exclude_radius_mm) + ".." + number(ch.range_end_mm) + " mm spans only " +
           number(ch.range_diffusion_lengths, 2) + " diffuse mean free paths (1/sigma_tr = " +
-          number(1 / sigma_tr) +
-          " mm; about 3 are needed to separate sigma_a from sigma_s'): distrust this channel, or "
+          // A sigma_a fitted to 0 has no diffuse mean free path: said in words, never "inf".
+          (sigma_tr > 0 ? number(1 / sigma_tr) + " mm" : std::string("unbounded: sigma_a fitted 0")) +
+          "; about 3 are needed to separate sigma_a from sigma_s'): distrust this channel, or "
           "image farther out (larger field, longer exposure)");
     }
   }
