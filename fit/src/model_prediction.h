@@ -23,6 +23,19 @@ struct GaussLegendre {
 };
 GaussLegendre gauss_legendre(int order);
 
+/// The mean of at(px, py) over the square pixel of side `pixel` centred at (x, y), by
+/// Gauss-Legendre in both directions; at(x, y) itself when `pixel` is 0 (a point).
+template <typename T, typename F>
+T footprint_mean(const F& at, double x, double y, double pixel, const GaussLegendre& gl) {
+  if (!(pixel > 0)) return at(x, y);
+  T sum(0);
+  for (int a = 0; a < gl.order; ++a)
+    for (int b = 0; b < gl.order; ++b)
+      sum += gl.weight[a] * gl.weight[b] *
+             at(x + (gl.node[a] - 0.5) * pixel, y + (gl.node[b] - 0.5) * pixel);
+  return sum;
+}
+
 /// Geometry shared by every sample of one capture.
 struct CaptureGeometry {
   double cos_incidence = 1;            ///< cos of the beam's polar angle
@@ -102,31 +115,15 @@ T ddipole_pixel(const materials::DirectionalDipole<T>& dd, const CaptureGeometry
     return T(std::numbers::pi) *
            dd.S_d(materials::Vec3<T>::Zero(), up, w_i, materials::Vec3<T>(T(px), T(py), T(0)), up);
   };
-  if (!(pixel > 0)) return at(x, y);
-  T sum(0);
-  for (int a = 0; a < gl.order; ++a) {
-    for (int b = 0; b < gl.order; ++b) {
-      sum += gl.weight[a] * gl.weight[b] *
-             at(x + (gl.node[a] - 0.5) * pixel, y + (gl.node[b] - 0.5) * pixel);
-    }
-  }
-  return sum;
+  return footprint_mean<T>(at, x, y, pixel, gl);
 }
 
 /// Standard dipole for a square pixel.
 template <typename T>
 T dipole_pixel(const materials::StandardDipole<T>& dipole, double x, double y, double pixel,
                const GaussLegendre& gl) {
-  if (!(pixel > 0)) return dipole.R_d(T(std::hypot(x, y)));
-  T sum(0);
-  for (int a = 0; a < gl.order; ++a) {
-    for (int b = 0; b < gl.order; ++b) {
-      sum +=
-          gl.weight[a] * gl.weight[b] *
-          dipole.R_d(T(std::hypot(x + (gl.node[a] - 0.5) * pixel, y + (gl.node[b] - 0.5) * pixel)));
-    }
-  }
-  return sum;
+  return footprint_mean<T>([&](double px, double py) { return dipole.R_d(T(std::hypot(px, py))); },
+                          x, y, pixel, gl);
 }
 
 /// The tabulated model over an annulus (mean over area, nodes uniform in r^2) or at a point.
@@ -144,13 +141,8 @@ T tabulated_annulus(const materials::TabulatedModel<T>& m, materials::TableQuant
 template <typename T>
 T tabulated_pixel(const materials::TabulatedModel<T>& m, materials::TableQuantity q, double x,
                   double y, double pixel, const GaussLegendre& gl) {
-  if (!(pixel > 0)) return m.at(q, T(std::hypot(x, y)));
-  T sum(0);
-  for (int a = 0; a < gl.order; ++a)
-    for (int b = 0; b < gl.order; ++b)
-      sum += gl.weight[a] * gl.weight[b] *
-             m.at(q, T(std::hypot(x + (gl.node[a] - 0.5) * pixel, y + (gl.node[b] - 0.5) * pixel)));
-  return sum;
+  return footprint_mean<T>([&](double px, double py) { return m.at(q, T(std::hypot(px, py))); },
+                          x, y, pixel, gl);
 }
 
 /// Oblique incidence, the tabulated model's way (a Monte Carlo correction of the directional
@@ -172,13 +164,7 @@ T corrected_ddipole_pixel(const materials::TabulatedModel<T>& tab,
     if (!(normal > T(0))) return T(0);
     return oblique / normal * tab.at(q, T(r));
   };
-  if (!(pixel > 0)) return at(x, y);
-  T sum(0);
-  for (int a = 0; a < gl.order; ++a)
-    for (int b = 0; b < gl.order; ++b)
-      sum += gl.weight[a] * gl.weight[b] *
-             at(x + (gl.node[a] - 0.5) * pixel, y + (gl.node[b] - 0.5) * pixel);
-  return sum;
+  return footprint_mean<T>(at, x, y, pixel, gl);
 }
 
 /// Oblique incidence with an oblique table slice at the capture's incidence (exact to transport):
@@ -195,14 +181,8 @@ T oblique_pixel(const materials::ObliqueModel<T>& m, materials::TableQuantity q,
   const auto at = [&](double px, double py) {
     return m.at(q, px * tx + py * ty, -px * ty + py * tx);
   };
-  if (!(pixel > 0)) return at(x, y);
-  T sum(0);
-  for (int a = 0; a < gl.order; ++a)
-    for (int b = 0; b < gl.order; ++b)
-      sum += gl.weight[a] * gl.weight[b] *
-             at(x + (gl.node[a] - 0.5) * pixel, y + (gl.node[b] - 0.5) * pixel);
   // The beam's single-scattering line, where it crosses the pixel (not a quadrature's business).
-  return sum + m.line_in_square(q, x - 0.5 * pixel, x + 0.5 * pixel, y - 0.5 * pixel,
+  return footprint_mean<T>(at, x, y, pixel, gl) + m.line_in_square(q, x - 0.5 * pixel, x + 0.5 * pixel, y - 0.5 * pixel,
                                 y + 0.5 * pixel, tx, ty);
 }
 
