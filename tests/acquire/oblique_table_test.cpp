@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include <ceres/jet.h>
+
 #include "lucent/acquire/photon_transport.h"
 #include "lucent/acquire/tabulate.h"
 #include "lucent/materials/error.h"
@@ -109,6 +111,31 @@ TEST(ObliqueModel, SingleScatteringLineInSquares) {
   EXPECT_EQ(m.line_in_square(TableQuantity::kExitance, 0.2, 0.7, -0.1, 0.4, 1, 0), 0.0);
   // A beam toward +y crossing the turned square.
   EXPECT_NEAR(m.line_in_square(q, -0.4, 0.1, 0.2, 0.7, 0, 1), a, 1e-12 * a);
+}
+
+// The stability sweep (stability_test.cpp) for the oblique model of the shipped slice: alpha'
+// 1e-6 .. 1 - 1e-8, 1e-6 .. 1e4 transport mean free paths in every direction, values, line term
+// and Jet derivatives finite and >= 0.
+TEST(ObliqueModel, ShippedSliceStaysFiniteAtEveryExtreme) {
+  using J = ceres::Jet<double, 2>;
+  const materials::TransportTable table =
+      materials::read_transport_table(materials::default_oblique_table_path());
+  const materials::ObliqueProfile profile(table, 1.5, 0.0, 45.0);
+  for (double one_minus : {1 - 1e-6, 0.5, 1e-2, 1e-4, 1e-6, 1e-8}) {
+    const double alpha = 1 - one_minus;
+    const materials::Medium<J> m{J(1 - alpha, 0), J(alpha, 1), J(0.0), J(1.5)};
+    const materials::ObliqueModel<J> model(profile, m);
+    for (double r = 1e-6; r < 2e4; r *= 10) {
+      for (double phi : {0.0, 0.7, 1.6, 3.1}) {
+        const double x = r * std::cos(phi), y = r * std::sin(phi);
+        for (TableQuantity q : {TableQuantity::kExitance, TableQuantity::kRadiance}) {
+          const J v = model.at(q, x, y) + model.line_in_square(q, x, x + r, y - r, y + r, 1, 0);
+          EXPECT_TRUE(std::isfinite(v.a) && v.a >= 0) << alpha << " " << r << " " << phi;
+          EXPECT_TRUE(std::isfinite(v.v[0]) && std::isfinite(v.v[1])) << alpha << " " << r;
+        }
+      }
+    }
+  }
 }
 
 // The shipped slice (eta 1.5, g 0, 45 degrees: marble_45deg) against the capture simulator's
