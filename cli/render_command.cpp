@@ -32,6 +32,7 @@ struct RenderArguments {
   std::string output;
   std::string stats;
   std::vector<int> snapshots;
+  bool json = false;
 };
 
 // OUT.exr -> OUT.f<t>.exr (the snapshot of frame t, always linear EXR).
@@ -99,7 +100,31 @@ void run_render(RenderArguments& render_args) {
   std::string extension = std::filesystem::path(render_args.output).extension().string();
   for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
   const bool png = extension == ".png";  // EXR is written linear, without the exposure
-  std::printf("render: wrote %s (%dx%d, %s, %s on %s, %s%s) in %.1f s\n", render_args.output.c_str(),
+  nlohmann::json doc = stats.to_json();
+  doc["scene"] = {{"material", scene.material.name},
+                  {"model", materials::to_string(args.settings.model)},
+                  {"mesh", scene.mesh.name},
+                  {"triangles", scene.mesh.triangles.size()},
+                  {"object_size_mm", args.object_size_mm},
+                  {"lights", scene.lights.size()},
+                  {"environment", args.env},
+                  {"view", args.view}};
+  if (args.technique == "maps") doc["settings"] = args.settings.to_string();
+  if (!render_args.stats.empty()) {
+    check_finite_json(doc, render_args.stats);
+    write_file_atomically(render_args.stats, doc.dump(2) + "\n");
+  }
+  if (render_args.json) {
+    // The summary line as JSON, with the statistics (the same document as --stats).
+    doc["output"] = render_args.output;
+    doc["seconds"] = seconds;
+    doc["exposure"] = png ? nlohmann::json(tone.exposure) : nlohmann::json(nullptr);
+    doc["auto_exposure"] = png && args.auto_exposure;
+    if (!render_args.stats.empty()) doc["stats_file"] = render_args.stats;
+    check_finite_json(doc, "render --json");
+    std::printf("%s\n", doc.dump(2).c_str());
+  } else {
+    std::printf("render: wrote %s (%dx%d, %s, %s on %s, %s%s) in %.1f s\n", render_args.output.c_str(),
               scene.camera.width, scene.camera.height,
               args.technique == "maps" ? "radiance maps" : "CPU reference",
               materials::to_string(args.settings.model).c_str(), scene.mesh.name.c_str(),
@@ -107,19 +132,6 @@ void run_render(RenderArguments& render_args) {
               png ? (std::to_string(tone.exposure) + (args.auto_exposure ? " (auto)" : "")).c_str()
                   : "",
               seconds);
-  if (!render_args.stats.empty()) {
-    nlohmann::json doc = stats.to_json();
-    doc["scene"] = {{"material", scene.material.name},
-                    {"model", materials::to_string(args.settings.model)},
-                    {"mesh", scene.mesh.name},
-                    {"triangles", scene.mesh.triangles.size()},
-                    {"object_size_mm", args.object_size_mm},
-                    {"lights", scene.lights.size()},
-                    {"environment", args.env},
-                    {"view", args.view}};
-    if (args.technique == "maps") doc["settings"] = args.settings.to_string();
-    check_finite_json(doc, render_args.stats);
-    write_file_atomically(render_args.stats, doc.dump(2) + "\n");
   }
   if (!args.default_rig.empty()) {
     std::string rig;
@@ -148,6 +160,9 @@ void register_render_command(CLI::App& app) {
       ->delimiter(',');
   cmd->add_option("--stats", args->stats,
                   "write timings (per pass or phase, ms) and counts as JSON (lucent-render-stats)");
+  cmd->add_flag("--json", args->json,
+                 "print what was written as JSON on stdout (output, size, technique, model, mesh, "
+                 "exposure, time and the --stats document) instead of the summary line");
   cmd->callback([args] { run_render(*args); });
 }
 

@@ -256,3 +256,30 @@ TEST(RenderCommand, SnapshotsAndCompare) {
 
 }  // namespace
 }  // namespace lucent::testing
+
+namespace lucent::testing {
+namespace {
+
+// --json: the summary as one JSON document on stdout (what a pipeline reads), the --stats
+// document inside it.
+TEST(RenderCommand, JsonSummaryOnStdout) {
+  const auto dir = scratch_dir("render-json");
+  const fs::path out = dir / "s.png";
+  const auto r = run_lucent(kTiny + "--material marble --mesh sphere --light directional:1,1,1:2,2,2 "
+                                    "--json -o \"" + out.string() + "\"",
+                            "json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto doc = nlohmann::json::parse(r.out);
+  EXPECT_EQ(doc.at("output"), out.string());
+  EXPECT_EQ(doc.at("technique"), "reference");
+  EXPECT_EQ(doc.at("width"), 24);
+  EXPECT_EQ(doc.at("scene").at("mesh"), "sphere");
+  EXPECT_TRUE(doc.at("auto_exposure").get<bool>());
+  EXPECT_GT(doc.at("exposure").get<double>(), 0);
+  EXPECT_GT(doc.at("seconds").get<double>(), 0);
+  EXPECT_TRUE(fs::exists(out));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace lucent::testing
