@@ -1,5 +1,6 @@
 // Finding or building the oblique slice of a fit (oblique_table.h).
 #include "oblique_table.h"
+#include "progress.h"
 
 #include <chrono>
 #include <cmath>
@@ -69,19 +70,10 @@ std::optional<materials::TransportTable> oblique_table_for(
               << g << ", incidence " << *incidence << " degrees (" << photons
               << " photons; kept in " << (cached.empty() ? std::string("no cache") : cached.string())
               << ")\n";
-  const auto start = std::chrono::steady_clock::now();
-  auto last = start;
-  const auto progress = [&](std::uint64_t done, std::uint64_t total) {
-    const auto now = std::chrono::steady_clock::now();
-    if (quiet || done == 0 || now - last < std::chrono::seconds(2)) return;
-    last = now;
-    const double elapsed = std::chrono::duration<double>(now - start).count();
-    std::cerr << "\rlucent fit: oblique table " << 100 * done / std::max<std::uint64_t>(total, 1)
-              << "%, " << int(elapsed * double(total - done) / double(done)) << " s left   "
-              << std::flush;
-  };
+  ProgressLine line("lucent fit: oblique table", "white-run photons", quiet);
+  const auto progress = [&](std::uint64_t done, std::uint64_t total) { line.update(done, total); };
   materials::TransportTable t = acquire::tabulate_transport(o, progress);
-  if (!quiet && last != start) std::cerr << "\r" << std::string(50, ' ') << "\r";
+  line.finish();
   if (!cached.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);

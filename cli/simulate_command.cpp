@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "commands.h"
+#include "progress.h"
 #include "validators.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/acquire/simulate.h"
@@ -87,17 +88,10 @@ void run(SimulateArguments& args) {
     o.exitance_csv = args.exitance_csv;
   }
 
-  const auto start = std::chrono::steady_clock::now();
-  auto last = start;
-  const auto progress = [&](std::uint64_t done, std::uint64_t total) {
-    const auto now = std::chrono::steady_clock::now();
-    if (args.quiet || args.json || now - last < std::chrono::seconds(1)) return;
-    last = now;
-    std::cerr << "\rsimulate: " << (100 * done / std::max<std::uint64_t>(total, 1)) << "% of "
-              << total << " photons" << std::flush;
-  };
+  ProgressLine line("simulate", "photons", args.quiet || args.json);
+  const auto progress = [&](std::uint64_t done, std::uint64_t total) { line.update(done, total); };
   const acquire::SimulateSummary summary = acquire::run_simulation(o, args.output, progress);
-  if (!args.quiet && !args.json && last != start) std::cerr << "\r" << std::string(50, ' ') << "\r";
+  line.finish();
 
   const auto& t = summary.transport;
   if (args.json) {

@@ -8,6 +8,7 @@
 
 #include "batch.h"
 #include "commands.h"
+#include "progress.h"
 #include "validators.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/acquire/tabulate.h"
@@ -47,13 +48,6 @@ std::vector<double> parse_list(const std::string& text, const std::string& optio
   return out;
 }
 
-std::string duration(double seconds) {
-  std::ostringstream s;
-  if (seconds >= 3600) s << int(seconds / 3600) << " h ";
-  if (seconds >= 60) s << int(std::fmod(seconds, 3600) / 60) << " min ";
-  s << int(std::fmod(seconds, 60)) << " s";
-  return s.str();
-}
 
 void run(TabulateArguments& args) {
   check_output_file(args.output, "", "-o");  // before hours of transport, not after
@@ -90,29 +84,20 @@ void run(TabulateArguments& args) {
       throw Error("--shard: expected I/N (0-based shard I of N), got '" + args.shard + "'");
     }
   }
-  const auto start = std::chrono::steady_clock::now();
-  auto last = start;
-  const auto progress = [&](std::uint64_t done, std::uint64_t total) {
-    const auto now = std::chrono::steady_clock::now();
-    if (args.quiet || now - last < std::chrono::seconds(2) || done == 0) return;
-    last = now;
-    const double elapsed = std::chrono::duration<double>(now - start).count();
-    const double left = elapsed * double(total - done) / double(done);
-    std::cerr << "\rtabulate: " << (100 * done / std::max<std::uint64_t>(total, 1)) << "% of "
-              << total << " photons, " << duration(left) << " left   " << std::flush;
-  };
+  // The white runs' photons are counted (the direct runs' are short).
+  ProgressLine line("tabulate", "white-run photons", args.quiet);
+  const auto progress = [&](std::uint64_t done, std::uint64_t total) { line.update(done, total); };
   const materials::TransportTable table = acquire::tabulate_transport(o, progress);
   materials::write_transport_table(table, args.output);
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = line.seconds();
+  line.finish();
   if (!args.quiet) {
-    if (last != start) std::cerr << "\r" << std::string(60, ' ') << "\r";
     std::cout << "wrote " << (table.partial ? "shard " + table.shard + " " : std::string())
               << args.output << ": " << table.slice_axes.size() << " slices (eta x g"
               << (oblique ? " x incidence" : "") << "), " << table.grid.u.size() << " albedos x "
               << (oblique ? std::to_string(table.grid.phi_bins) + " azimuths x " : std::string())
               << table.grid.rho_bins() << " radii, " << std::uint64_t(table.slice_axes.front()[2]) << " photons per slice, in "
-              << duration(seconds) << '\n';
+              << duration_text(seconds) << '\n';
   }
 }
 

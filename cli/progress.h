@@ -1,0 +1,67 @@
+// Progress of a long command on stderr: on a terminal one line redrawn at most once a second with
+// the share done and the time left; elsewhere (a log, a job array's output) one line per tenth,
+// so that a log shows the stages without a carriage-return smear. Nothing in the first second (a
+// short run prints only its result). No CLI11 here.
+#pragma once
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+
+namespace lucent::cli {
+
+/// "1 h 2 min 3 s", "4 min 5 s", "6 s".
+inline std::string duration_text(double seconds) {
+  const long s = std::lround(std::max(0.0, seconds));
+  std::string out;
+  if (s >= 3600) out += std::to_string(s / 3600) + " h ";
+  if (s >= 60) out += std::to_string((s % 3600) / 60) + " min ";
+  return out + std::to_string(s % 60) + " s";
+}
+
+class ProgressLine {
+ public:
+  /// `what`: the command's name; `unit`: what is counted ("photons"). Quiet: prints nothing.
+  ProgressLine(std::string what, std::string unit, bool quiet)
+      : what_(std::move(what)), unit_(std::move(unit)), quiet_(quiet),
+        terminal_(::isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()),
+        last_(start_) {}
+
+  void update(std::uint64_t done, std::uint64_t total) {
+    if (quiet_ || done == 0 || total == 0) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - start_ < std::chrono::seconds(1)) return;  // a short run shows nothing
+    const int tenth = int(10 * done / total);
+    if (terminal_ ? now - last_ < std::chrono::seconds(1) : tenth <= last_tenth_) return;
+    last_ = now;
+    last_tenth_ = tenth;
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    const double left = elapsed * double(total - done) / double(done);
+    std::fprintf(stderr, "%s%s: %d%% of %llu %s, %s left%s", terminal_ ? "\r" : "", what_.c_str(),
+                 int(100 * done / total), static_cast<unsigned long long>(total), unit_.c_str(),
+                 duration_text(left).c_str(), terminal_ ? "   " : "\n");
+    std::fflush(stderr);
+    drawn_ = true;
+  }
+  /// Clears a terminal's line (call before printing the result).
+  void finish() {
+    if (drawn_ && terminal_) std::fprintf(stderr, "\r%s\r", std::string(70, ' ').c_str());
+    drawn_ = false;
+  }
+  double seconds() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+
+ private:
+  std::string what_, unit_;
+  bool quiet_, terminal_;
+  std::chrono::steady_clock::time_point start_, last_;
+  int last_tenth_ = 0;
+  bool drawn_ = false;
+};
+
+}  // namespace lucent::cli
