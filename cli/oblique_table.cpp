@@ -1,8 +1,6 @@
 // Finding or building the oblique slice of a fit (oblique_table.h).
 #include "oblique_table.h"
-#include "progress.h"
 
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -12,6 +10,7 @@
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
 #include "lucent/materials/oblique.h"
+#include "progress.h"
 
 namespace lucent::cli {
 

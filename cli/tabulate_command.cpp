@@ -5,6 +5,7 @@
 #include <iostream>
 #include <memory>
 #include <sstream>
+#include <tuple>
 
 #include "batch.h"
 #include "commands.h"
@@ -49,16 +50,22 @@ std::vector<double> parse_list(const std::string& text, const std::string& optio
 }
 
 
+// Shards (and finished tables of other slices) merged into one table file; its slice count.
+std::size_t merge_table_files(const std::vector<std::string>& inputs, const std::string& output) {
+  std::vector<materials::TransportTable> parts;
+  for (const std::string& p : inputs) parts.push_back(materials::read_transport_table(p));
+  const materials::TransportTable table = materials::merge_transport_tables(parts);
+  materials::write_transport_table(table, output);
+  return table.slices.size();
+}
+
 void run(TabulateArguments& args) {
   check_output_file(args.output, "", "-o");  // before hours of transport, not after
   if (!args.merge.empty()) {
-    std::vector<materials::TransportTable> parts;
-    for (const std::string& p : args.merge) parts.push_back(materials::read_transport_table(p));
-    const materials::TransportTable table = materials::merge_transport_tables(parts);
-    materials::write_transport_table(table, args.output);
+    const std::size_t slices = merge_table_files(args.merge, args.output);
     if (!args.quiet)
-      std::cout << "merged " << parts.size() << " shards into " << args.output << " ("
-                << table.slices.size() << " slices)\n";
+      std::cout << "merged " << args.merge.size() << " shards into " << args.output << " ("
+                << slices << " slices)\n";
     return;
   }
   acquire::TabulateOptions& o = args.options;
@@ -71,19 +78,8 @@ void run(TabulateArguments& args) {
     o.grid = materials::default_oblique_grid();
   }
   if (args.phi_bins > 0) o.grid.phi_bins = args.phi_bins;
-  if (!args.shard.empty()) {
-    const auto slash = args.shard.find('/');
-    try {
-      if (slash == std::string::npos) throw std::invalid_argument(args.shard);
-      std::size_t u1 = 0, u2 = 0;
-      const std::string a = args.shard.substr(0, slash), b = args.shard.substr(slash + 1);
-      o.shard_index = std::stoi(a, &u1);
-      o.shard_count = std::stoi(b, &u2);
-      if (u1 != a.size() || u2 != b.size()) throw std::invalid_argument(args.shard);
-    } catch (const std::exception&) {
-      throw Error("--shard: expected I/N (0-based shard I of N), got '" + args.shard + "'");
-    }
-  }
+  if (!args.shard.empty())
+    std::tie(o.shard_index, o.shard_count) = parse_shard(args.shard, "--shard");
   // The white runs' photons are counted (the direct runs' are short).
   ProgressLine line("tabulate", "white-run photons", args.quiet);
   const auto progress = [&](std::uint64_t done, std::uint64_t total) { line.update(done, total); };
@@ -162,9 +158,7 @@ void register_merge_command(CLI::App& app) {
     const bool tables = std::filesystem::path(inputs->front()).extension() == ".lut";
     check_output_file(*output, tables ? ".lut" : ".json", "-o");
     if (tables) {
-      std::vector<materials::TransportTable> parts;
-      for (const std::string& p : *inputs) parts.push_back(materials::read_transport_table(p));
-      materials::write_transport_table(materials::merge_transport_tables(parts), *output);
+      merge_table_files(*inputs, *output);
     } else {
       std::vector<nlohmann::json> parts;
       for (const std::string& p : *inputs) parts.push_back(read_json_file(p));
