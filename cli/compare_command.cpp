@@ -9,8 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "lucent/imaging/image_io.h"
 #include "lucent/materials/atomic_file.h"
-#include "lucent/acquire/image_io.h"
 #include "lucent/materials/error.h"
 #include "lucent/render/image_compare.h"
 #include "lucent/render/tone_map.h"
@@ -28,8 +28,8 @@ struct CompareArguments {
 
 void run_compare(const CompareArguments& args) {
   if (!args.difference.empty()) check_output_file(args.difference, "", "--difference");
-  const render::ImageRgb image = acquire::read_exr(args.image);
-  const render::ImageRgb reference = acquire::read_exr(args.reference);
+  const render::ImageRgb image = imaging::read_exr(args.image);
+  const render::ImageRgb reference = imaging::read_exr(args.reference);
   const render::ImageDifference d =
       render::compare_images(image, reference, render::nonzero_mask(reference));
   if (!args.difference.empty()) {
@@ -41,7 +41,8 @@ void run_compare(const CompareArguments& args) {
       if (!mask[p]) continue;
       if (args.signed_difference) {  // red: the image is brighter; blue: darker (mean of RGB)
         double delta = 0;
-        for (int c = 0; c < 3; ++c) delta += image.data[3 * p + std::size_t(c)] - reference.data[3 * p + std::size_t(c)];
+        for (int c = 0; c < 3; ++c)
+          delta += image.data[3 * p + std::size_t(c)] - reference.data[3 * p + std::size_t(c)];
         delta /= 3 * d.reference_mean;
         diff.data[3 * p] = float(std::max(0.0, delta));
         diff.data[3 * p + 2] = float(std::max(0.0, -delta));
@@ -84,10 +85,11 @@ void register_compare_command(CLI::App& app) {
   cmd->add_option("reference", args->reference, "the reference (.exr), e.g. --technique reference")
       ->required();
   cmd->add_flag("--json", args->json, "print a JSON summary (lucent-image-difference)");
-  cmd->add_option("--difference", args->difference,
-                  "also write |image - reference| / the reference's mean as an image (.png or .exr)");
+  cmd->add_option(
+      "--difference", args->difference,
+      "also write |image - reference| / the reference's mean as an image (.png or .exr)");
   cmd->add_flag("--signed", args->signed_difference,
-               "--difference: red where the image is brighter, blue where darker");
+                "--difference: red where the image is brighter, blue where darker");
   cmd->add_option("--scale", args->scale, "--difference: multiplier before the tone curve")
       ->capture_default_str();
   cmd->callback([args] { run_compare(*args); });

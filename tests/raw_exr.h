@@ -9,11 +9,11 @@
 
 #include <filesystem>
 
-#include "lucent/acquire/image.h"
+#include "lucent/imaging/image.h"
 
 namespace lucent::testing {
 
-inline void write_raw_exr(const std::filesystem::path& path, const acquire::ImageRgb& image) {
+inline void write_raw_exr(const std::filesystem::path& path, const imaging::ImageRgb& image) {
   Imf::Header header(image.width, image.height);
   const char* names[3] = {"R", "G", "B"};
   for (const char* c : names) header.channels().insert(c, Imf::Channel(Imf::FLOAT));

@@ -10,7 +10,7 @@
 #include "lucent/acquire/camera.h"
 #include "lucent/acquire/capture.h"
 #include "lucent/acquire/hdr_merge.h"
-#include "lucent/acquire/image_io.h"
+#include "lucent/imaging/image_io.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
 #include "lucent/version.h"
@@ -105,9 +105,10 @@ BeamPower white_reference_power(const HdrResult& white, double reflectance, doub
 // The picture for a person: log tone mapping between the 1st and 99.9th percentile luminance, sRGB,
 // masked pixels magenta, the entry point as a cross and rings at every n-th bin edge. Small images
 // are enlarged (nearest neighbour) so that the marks stay legible.
-RawImage overview_image(const HdrResult& hdr, const std::array<double, 2>& beam_point_px,
-                        const std::vector<double>& edges_mm, double pixel_pitch_mm, int ring_every,
-                        const std::string& caption_top, const std::string& caption_bottom) {
+imaging::RawImage overview_image(const HdrResult& hdr, const std::array<double, 2>& beam_point_px,
+                                 const std::vector<double>& edges_mm, double pixel_pitch_mm,
+                                 int ring_every, const std::string& caption_top,
+                                 const std::string& caption_bottom) {
   const int w = hdr.width(), h = hdr.height();
   const double kLum[3] = {0.2126, 0.7152, 0.0722};
   std::vector<double> luminance(std::size_t(w) * h, 0.0), positive;
@@ -197,7 +198,7 @@ RawImage overview_image(const HdrResult& hdr, const std::array<double, 2>& beam_
               cv::FONT_HERSHEY_SIMPLEX, font, cv::Scalar(230, 230, 230), std::max(1, int(font * 2)),
               cv::LINE_AA);
 
-  RawImage out(image.cols, image.rows, 255);
+  imaging::RawImage out(image.cols, image.rows, 255);
   for (int y = 0; y < image.rows; ++y) {
     for (int x = 0; x < image.cols; ++x) {
       for (int c = 0; c < 3; ++c) out.at(x, y, c) = image.at<cv::Vec3b>(y, x)[c];
@@ -361,7 +362,7 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
 
   // capture.exr: radiance per unit beam power when calibrated (comparable with the simulator's
   // truth), per second of exposure in the capture's units otherwise.
-  ImageRgb radiance = hdr.radiance;
+  imaging::ImageRgb radiance = hdr.radiance;
   if (summary.calibrated) {
     for (std::size_t i = 0; i < radiance.data.size(); ++i) {
       radiance.data[i] = float(radiance.data[i] / (*summary.beam_power)[i % 3]);
@@ -380,8 +381,8 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
                                      " bins (" + (options.log_bins ? "log" : "linear") +
                                      "), outer " + number(summary.radius_mm) + " mm" +
                                      (summary.calibrated ? "" : "; uncalibrated");
-  const RawImage overview = overview_image(hdr, bp, edges, capture.pixel_pitch_mm,
-                                           options.ring_every_bins, caption_top, caption_bottom);
+  const imaging::RawImage overview = overview_image(
+      hdr, bp, edges, capture.pixel_pitch_mm, options.ring_every_bins, caption_top, caption_bottom);
 
   const std::map<std::string, std::string> attributes = {
       {"lucent.format", "lucent-hdr-capture"},
@@ -393,10 +394,10 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
        "0 where masked (saturated or black in every bracket, or non-finite); "
        "counts in profile.json"},
       {"lucent.capture", capture_json.string()}};
-  write_exr(out.temporary() / "capture.exr", radiance, attributes);
+  imaging::write_exr(out.temporary() / "capture.exr", radiance, attributes);
   write_profile(out.temporary() / "profile.json", profile);
   write_file_atomically(out.temporary() / "profile.csv", profile_csv(profile));
-  write_png(out.temporary() / "acquire.png", overview);
+  imaging::write_png(out.temporary() / "acquire.png", overview);
   out.commit();
   for (const char* name : {"capture.exr", "profile.json", "profile.csv", "acquire.png"}) {
     summary.files.push_back(out_dir / name);

@@ -1,8 +1,8 @@
 #include "lucent/acquire/camera.h"
 
-#include <cstdio>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "lucent/materials/error.h"
@@ -68,8 +68,10 @@ void validate_camera_options(const CameraOptions& o) {
   }
   if (!(o.electrons_per_radiance_s == 0 ||
         (o.electrons_per_radiance_s > 0 && o.electrons_per_radiance_s <= 1e30))) {
-    throw Error("--camera-scale: expected electrons per (radiance s) in (0, 1e30], or 0 for "
-                "automatic, got " + number(o.electrons_per_radiance_s));
+    throw Error(
+        "--camera-scale: expected electrons per (radiance s) in (0, 1e30], or 0 for "
+        "automatic, got " +
+        number(o.electrons_per_radiance_s));
   }
   if (!(o.auto_fill > 0 && o.auto_fill <= 1)) {
     throw Error("camera: auto_fill must be in (0, 1], got " + number(o.auto_fill));
@@ -85,11 +87,11 @@ double camera_scale(const CameraOptions& options, double peak_radiance) {
          (peak_radiance * options.exposures_s.front());
 }
 
-RawImage expose(const ImageRgb& radiance, double exposure_s, double scale,
-                const CameraOptions& options, std::uint64_t stream) {
+imaging::RawImage expose(const imaging::ImageRgb& radiance, double exposure_s, double scale,
+                         const CameraOptions& options, std::uint64_t stream) {
   validate_camera_options(options);
   const int max_value = options.bits == 8 ? 255 : 65535;
-  RawImage out(radiance.width, radiance.height, max_value);
+  imaging::RawImage out(radiance.width, radiance.height, max_value);
   std::mt19937_64 rng(splitmix64(options.seed ^ splitmix64(stream)));
   std::normal_distribution<double> gauss(0.0, 1.0);
   for (std::size_t i = 0; i < radiance.data.size(); ++i) {

@@ -7,7 +7,7 @@
 #include <opencv2/photo.hpp>
 
 #include "lucent/acquire/camera.h"
-#include "lucent/acquire/image_io.h"
+#include "lucent/imaging/image_io.h"
 #include "lucent/materials/error.h"
 
 namespace lucent::acquire {
@@ -118,7 +118,7 @@ std::array<double, 2> fit_variance_model(std::vector<Row>& rows, const std::vect
 }
 
 struct Stack {
-  std::vector<RawImage> images;
+  std::vector<imaging::RawImage> images;
   std::vector<double> exposure_s;
   std::vector<fs::path> paths;
 };
@@ -127,9 +127,9 @@ Stack read_stack(const ImageSet& set, const fs::path& base_dir) {
   Stack stack;
   for (const Bracket& b : set.images) {
     const fs::path path = resolve(base_dir, b.path);
-    RawImage image = read_raw_image(path);
+    imaging::RawImage image = imaging::read_raw_image(path);
     if (!stack.images.empty()) {
-      const RawImage& first = stack.images.front();
+      const imaging::RawImage& first = stack.images.front();
       if (image.width != first.width || image.height != first.height) {
         throw Error(path.string() + ": image is " + size_text(image.width, image.height) +
                     " pixels but " + stack.paths.front().string() + " is " +
@@ -196,7 +196,7 @@ void require_usable_pixels(const HdrResult& result, const std::string& sources) 
 // medians of the squared spread in 32 brightness groups (robust against edges), then a weighted
 // non-negative fit. Fills result.noise.
 void fit_neighbour_noise(HdrResult& result) {
-  const ImageRgb& image = result.radiance;
+  const imaging::ImageRgb& image = result.radiance;
   const int w = image.width, h = image.height;
   result.noise = {};
   result.noise.source = "neighbours";
@@ -247,9 +247,9 @@ HdrResult read_hdr(const ImageSet& set, const std::optional<fs::path>& dark,
   const fs::path path = resolve(base_dir, *set.hdr);
   result.sources = {path};
   result.sources_text = path.string();
-  result.radiance = read_exr(path);
+  result.radiance = imaging::read_exr(path);
   const int w = result.radiance.width, h = result.radiance.height;
-  ImageRgb dark_image;
+  imaging::ImageRgb dark_image;
   if (dark) {
     const fs::path dark_path = resolve(base_dir, *dark);
     std::string ext = dark_path.extension().string();
@@ -260,7 +260,7 @@ HdrResult read_hdr(const ImageSet& set, const std::optional<fs::path>& dark,
                   ": with an 'hdr' capture the dark frame must be an OpenEXR "
                   "image in the same units");
     }
-    dark_image = read_exr(dark_path);
+    dark_image = imaging::read_exr(dark_path);
     if (dark_image.width != w || dark_image.height != h) {
       throw Error(dark_path.string() + ": dark frame is " +
                   size_text(dark_image.width, dark_image.height) + " pixels but " + path.string() +
@@ -268,7 +268,7 @@ HdrResult read_hdr(const ImageSet& set, const std::optional<fs::path>& dark,
     }
     result.sources.push_back(dark_path);
   }
-  result.standard_error = ImageRgb(w, h, 0.0f);
+  result.standard_error = imaging::ImageRgb(w, h, 0.0f);
   result.mask.assign(result.radiance.data.size(), PixelMask::kValid);
   for (std::size_t i = 0; i < result.radiance.data.size(); ++i) {
     float& value = result.radiance.data[i];
@@ -292,8 +292,8 @@ HdrResult read_hdr(const ImageSet& set, const std::optional<fs::path>& dark,
 }
 
 HdrResult merge_stack(const Stack& stack, const ResponseCurve& curve,
-                      const std::optional<RawImage>& dark) {
-  const RawImage& first = stack.images.front();
+                      const std::optional<imaging::RawImage>& dark) {
+  const imaging::RawImage& first = stack.images.front();
   const int w = first.width, h = first.height, m = first.max_value;
   const std::size_t n = first.data.size(), brackets = stack.images.size();
   const int top = m - 1;
@@ -303,8 +303,8 @@ HdrResult merge_stack(const Stack& stack, const ResponseCurve& curve,
   const auto q2 = quantisation_variance(curve);
 
   HdrResult result;
-  result.radiance = ImageRgb(w, h, 0.0f);
-  result.standard_error = ImageRgb(w, h, 0.0f);
+  result.radiance = imaging::ImageRgb(w, h, 0.0f);
+  result.standard_error = imaging::ImageRgb(w, h, 0.0f);
   result.mask.assign(n, PixelMask::kValid);
   result.sources = stack.paths;
   result.sources_text = describe_sources(stack.paths);
@@ -506,7 +506,7 @@ ResponseCurve calibrate_response(const ImageSet& brackets, const fs::path& base_
   std::vector<cv::Mat> mats;
   std::vector<float> times;
   for (std::size_t k = 0; k < stack.images.size(); ++k) {
-    const RawImage& image = stack.images[k];
+    const imaging::RawImage& image = stack.images[k];
     cv::Mat mat(image.height, image.width, CV_8UC3);
     for (int y = 0; y < image.height; ++y) {
       for (int x = 0; x < image.width; ++x) {
@@ -559,11 +559,11 @@ HdrResult merge_brackets(const ImageSet& set, Response response,
   } else {
     used = standard_response(response, max_value);
   }
-  std::optional<RawImage> dark_image;
+  std::optional<imaging::RawImage> dark_image;
   if (dark) {
     const fs::path dark_path = resolve(base_dir, *dark);
-    dark_image = read_raw_image(dark_path);
-    const RawImage& first = stack.images.front();
+    dark_image = imaging::read_raw_image(dark_path);
+    const imaging::RawImage& first = stack.images.front();
     if (dark_image->width != first.width || dark_image->height != first.height) {
       throw Error(dark_path.string() + ": dark frame is " +
                   size_text(dark_image->width, dark_image->height) + " pixels but " +

@@ -1,11 +1,11 @@
-#include "lucent/materials/json_file.h"
 #include "lucent/acquire/simulate.h"
+#include "lucent/materials/json_file.h"
 
 #include <cmath>
 #include <numbers>
 #include <sstream>
 
-#include "lucent/acquire/image_io.h"
+#include "lucent/imaging/image_io.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/directional_dipole.h"
@@ -18,9 +18,9 @@ namespace {
 
 using nlohmann::json;
 
-ImageRgb to_image(const PhotonTransportResult& result, bool standard_error) {
+imaging::ImageRgb to_image(const PhotonTransportResult& result, bool standard_error) {
   const int size = result.options.size;
-  ImageRgb image(size, size);
+  imaging::ImageRgb image(size, size);
   for (int c = 0; c < 3; ++c) {
     const auto& ch = result.channels[c];
     const std::vector<double>& values = standard_error ? ch.image_standard_error : ch.image;
@@ -32,7 +32,7 @@ ImageRgb to_image(const PhotonTransportResult& result, bool standard_error) {
   return image;
 }
 
-double peak(const ImageRgb& image) {
+double peak(const imaging::ImageRgb& image) {
   double m = 0;
   for (float v : image.data) m = std::max(m, double(v));
   return m;
@@ -90,14 +90,14 @@ std::string bracket_name(const char* stem, std::size_t k) {
 
 }  // namespace
 
-ImageRgb model_radiance(const materials::Material& material, RadianceSource source,
-                        const PhotonTransportOptions& g) {
+imaging::ImageRgb model_radiance(const materials::Material& material, RadianceSource source,
+                                 const PhotonTransportOptions& g) {
   constexpr double kDegree = std::numbers::pi / 180;
   const double theta = g.incidence_deg * kDegree, phi = g.azimuth_deg * kDegree;
   const materials::Vec3<double> w_i(-std::sin(theta) * std::cos(phi),
                                     -std::sin(theta) * std::sin(phi), std::cos(theta));
   const materials::Vec3<double> up(0, 0, 1);
-  ImageRgb image(g.size, g.size);
+  imaging::ImageRgb image(g.size, g.size);
   for (int c = 0; c < 3; ++c) {
     const materials::Medium<double> medium = material.medium(c);
     const double fresnel =
@@ -128,8 +128,8 @@ ImageRgb model_radiance(const materials::Material& material, RadianceSource sour
   return image;
 }
 
-ImageRgb white_reference_radiance(int size, double pixel_mm, double rho, double sigma_mm) {
-  ImageRgb image(size, size);
+imaging::ImageRgb white_reference_radiance(int size, double pixel_mm, double rho, double sigma_mm) {
+  imaging::ImageRgb image(size, size);
   // The spot sits where the beam enters: the centre of the grid (x = y = 0 mm).
   const auto cdf = [&](double x) { return 0.5 * std::erfc(-x / (std::sqrt(2.0) * sigma_mm)); };
   const double area = pixel_mm * pixel_mm;
@@ -188,18 +188,18 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
   }
 
   if (!options.profile_only) {
-    const ImageRgb radiance = monte_carlo
-                                  ? to_image(result, false)
-                                  : model_radiance(options.material, options.source, transport);
+    const imaging::ImageRgb radiance =
+        monte_carlo ? to_image(result, false)
+                    : model_radiance(options.material, options.source, transport);
     const double pixel_area = transport.pixel_mm * transport.pixel_mm;
     const double scale = camera_scale(camera, peak(radiance));
     summary.camera_scale = scale;
-    write_exr(out.temporary() / "truth_radiance.exr", radiance,
-              {{"units", "radiance per unit incident power, mm^-2 sr^-1"}});
+    imaging::write_exr(out.temporary() / "truth_radiance.exr", radiance,
+                       {{"units", "radiance per unit incident power, mm^-2 sr^-1"}});
     summary.files = {"truth_radiance.exr"};
     if (monte_carlo) {
-      write_exr(out.temporary() / "truth_radiance_se.exr", to_image(result, true),
-                {{"units", "standard error of truth_radiance, mm^-2 sr^-1"}});
+      imaging::write_exr(out.temporary() / "truth_radiance_se.exr", to_image(result, true),
+                         {{"units", "standard error of truth_radiance, mm^-2 sr^-1"}});
       summary.files.push_back("truth_radiance_se.exr");
     }
 
@@ -220,7 +220,7 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
     for (std::size_t k = 0; k < camera.exposures_s.size(); ++k) {
       const double t = camera.exposures_s[k];
       const std::string name = bracket_name("bracket", k);
-      write_png(out.temporary() / name, expose(radiance, t, scale, camera, stream++));
+      imaging::write_png(out.temporary() / name, expose(radiance, t, scale, camera, stream++));
       capture.sample.images.push_back({name, t});
       summary.files.push_back(name);
     }
@@ -228,8 +228,8 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
     if (options.white_reference) {
       const double sigma =
           options.white_spot_sigma_mm > 0 ? options.white_spot_sigma_mm : transport.pixel_mm;
-      const ImageRgb white = white_reference_radiance(transport.size, transport.pixel_mm,
-                                                      options.white_reflectance, sigma);
+      const imaging::ImageRgb white = white_reference_radiance(transport.size, transport.pixel_mm,
+                                                               options.white_reflectance, sigma);
       // The reference is far brighter than the sample: shorten its exposures by a power of two so
       // that its peak, too, fills about auto_fill of the well at the shortest one.
       const double ratio = peak(white) / peak(radiance);
@@ -239,7 +239,7 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
       for (std::size_t k = 0; k < camera.exposures_s.size(); ++k) {
         const double t = camera.exposures_s[k] / shorten;
         const std::string name = bracket_name("white", k);
-        write_png(out.temporary() / name, expose(white, t, scale, camera, stream++));
+        imaging::write_png(out.temporary() / name, expose(white, t, scale, camera, stream++));
         reference.images.images.push_back({name, t});
         summary.files.push_back(name);
       }
@@ -249,9 +249,9 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
                     {"exposure_divisor", shorten}};
     }
     if (options.dark_frame) {
-      const ImageRgb black(transport.size, transport.size, 0.0f);
-      write_png(out.temporary() / "dark.png",
-                expose(black, camera.exposures_s.back(), scale, camera, stream++));
+      const imaging::ImageRgb black(transport.size, transport.size, 0.0f);
+      imaging::write_png(out.temporary() / "dark.png",
+                         expose(black, camera.exposures_s.back(), scale, camera, stream++));
       capture.dark = "dark.png";
       summary.files.push_back("dark.png");
     }

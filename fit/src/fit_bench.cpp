@@ -11,9 +11,9 @@
 #include <sstream>
 
 #include "lucent/acquire/acquire.h"
-#include "lucent/acquire/plot.h"
 #include "lucent/acquire/simulate.h"
 #include "lucent/fit/fit.h"
+#include "lucent/imaging/plot.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
 
@@ -149,7 +149,7 @@ int run_fit_bench(const FitBenchOptions& options, std::ostream& log) {
 
   fs::create_directories(options.out_dir);
   write_file_atomically(options.out_dir / "fit_tradeoff.csv", csv.str());
-  acquire::PlotPanel panel;
+  imaging::PlotPanel panel;
   panel.title =
       "fit speed against accuracy: mean relative parameter error vs median solve time "
       "(fast, balanced, accurate joined)";
@@ -168,7 +168,7 @@ int run_fit_bench(const FitBenchOptions& options, std::ostream& log) {
                                                              {100, 100, 230},
                                                              {230, 160, 160}}};
   for (std::size_t s = 0; s < series_names.size(); ++s) {
-    acquire::PlotSeries series;
+    imaging::PlotSeries series;
     series.rgb = palette[s % palette.size()];
     series.line = true;
     series.label = series_names[s];
@@ -177,7 +177,7 @@ int run_fit_bench(const FitBenchOptions& options, std::ostream& log) {
     }
     panel.series.push_back(series);
   }
-  acquire::write_plot_png(
+  imaging::write_plot_png(
       options.out_dir / "fit_tradeoff.png", {panel},
       {"error: mean over channels of |fitted / truth - 1| for sigma_a and sigma_s', averaged",
        "model-made captures have an exact truth for their model; the Monte Carlo one has none"},

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <numbers>
 
-#include "lucent/acquire/plot.h"
+#include "lucent/imaging/plot.h"
 #include "model_prediction.h"
 
 namespace lucent::fit {
@@ -21,15 +21,14 @@ double predicted_radial(const ModelFit& fit, const ProfileData& data, int c, dou
   // What the fit compares with: a pixel footprint at r when the bins are pixel averages.
   const detail::GaussLegendre gl = detail::gauss_legendre(2);
   const double p = data.radial.pixel_mm;
-  const double v =
-      detail::model_value(fit.model, table, medium, g, false, r, r, r, r, 0.0, p, gl);
+  const double v = detail::model_value(fit.model, table, medium, g, false, r, r, r, r, 0.0, p, gl);
   return fit.scale * fit.calibration_scale[c] * detail::fresnel_factor(g, fit.eta, fit.model) * v;
 }
 
 void write_fit_plot(const std::filesystem::path& path, const FitResult& result,
                     const ProfileData& data) {
-  using acquire::PlotPanel;
-  using acquire::PlotSeries;
+  using imaging::PlotPanel;
+  using imaging::PlotSeries;
   const std::array<std::array<std::uint8_t, 3>, 3> colours{
       {{200, 30, 30}, {30, 150, 30}, {30, 60, 210}}};
   const std::array<std::array<std::uint8_t, 3>, 3> light{
@@ -37,11 +36,9 @@ void write_fit_plot(const std::filesystem::path& path, const FitResult& result,
   const char* names[3] = {"R", "G", "B"};
   const ModelFit& f = result.chosen;
   PlotPanel profile;
-  profile.title =
-      "profile: data (points, +-1 SE) and " +
-      to_string(f.model) +
-      " fit (lines); excluded region in light colours; y: " +
-      (data.calibrated ? "pi L / P (1/mm^2)" : "pi L (relative)");
+  profile.title = "profile: data (points, +-1 SE) and " + to_string(f.model) +
+                  " fit (lines); excluded region in light colours; y: " +
+                  (data.calibrated ? "pi L / P (1/mm^2)" : "pi L (relative)");
   profile.x_label = "r (mm)";
   profile.log_y = true;
   profile.height_weight = 2.2;
@@ -105,7 +102,7 @@ void write_fit_plot(const std::filesystem::path& path, const FitResult& result,
                 f.converged ? "converged" : "NOT converged", f.iterations, f.time_ms);
   footer.push_back(line);
   footer.push_back("model choice: " + result.reason);
-  acquire::write_plot_png(path, {profile, residuals}, footer, 1100, 900);
+  imaging::write_plot_png(path, {profile, residuals}, footer, 1100, 900);
 }
 
 }  // namespace lucent::fit

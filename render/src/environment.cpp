@@ -7,7 +7,7 @@
 #include <numbers>
 #include <sstream>
 
-#include "lucent/acquire/image_io.h"
+#include "lucent/imaging/image_io.h"
 #include "lucent/materials/error.h"
 
 namespace lucent::render {
@@ -21,7 +21,6 @@ std::string lower_extension(const fs::path& path) {
   std::transform(e.begin(), e.end(), e.begin(), [](unsigned char ch) { return std::tolower(ch); });
   return e;
 }
-
 
 float luminance(float r, float g, float b) {
   return 0.2126f * r + 0.7152f * g + 0.0722f * b;
@@ -75,9 +74,9 @@ EnvironmentMap load_environment(const fs::path& path) {
   map.source = path;
   const std::string ext = lower_extension(path);
   if (ext == ".exr") {
-    map.image = acquire::read_exr(path);
+    map.image = imaging::read_exr(path);
   } else if (ext == ".hdr") {
-    map.image = acquire::read_radiance_hdr(path);
+    map.image = imaging::read_radiance_hdr(path);
   } else {
     throw Error(path.string() +
                 ": environment maps must be OpenEXR (.exr) or Radiance (.hdr) "
@@ -89,7 +88,8 @@ EnvironmentMap load_environment(const fs::path& path) {
     }
     // As for --light: the renderer sums radiance in float; 1e38 overflows at the first product.
     if (v > 1e12f) {
-      throw Error(path.string() + ": environment map has a pixel brighter than 1e12 (scale the "
+      throw Error(path.string() +
+                  ": environment map has a pixel brighter than 1e12 (scale the "
                   "map down; images are relative)");
     }
     v = std::max(v, 0.0f);  // negative radiance (from filtering or compression) is clamped to 0

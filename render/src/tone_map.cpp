@@ -5,7 +5,7 @@
 #include <cctype>
 #include <cmath>
 
-#include "lucent/acquire/image_io.h"
+#include "lucent/imaging/image_io.h"
 #include "lucent/materials/error.h"
 
 namespace lucent::render {
@@ -30,8 +30,8 @@ float srgb_encode(float linear) {
   return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
 }
 
-acquire::RawImage tone_map(const acquire::ImageRgb& linear, const ToneMapOptions& options) {
-  acquire::RawImage out(linear.width, linear.height, 255);
+imaging::RawImage tone_map(const imaging::ImageRgb& linear, const ToneMapOptions& options) {
+  imaging::RawImage out(linear.width, linear.height, 255);
   for (std::size_t i = 0; i < linear.data.size(); ++i) {
     const float v = srgb_encode(tone_curve(linear.data[i] * options.exposure));
     out.data[i] = static_cast<std::uint16_t>(std::lround(v * 255.0f));
@@ -44,20 +44,20 @@ bool is_render_image_path(const std::filesystem::path& path) {
   return e == ".png" || e == ".exr";
 }
 
-void write_render_image(const std::filesystem::path& path, const acquire::ImageRgb& linear,
+void write_render_image(const std::filesystem::path& path, const imaging::ImageRgb& linear,
                         const ToneMapOptions& options,
                         const std::map<std::string, std::string>& attributes) {
   const std::string e = lower_extension(path);
   if (e == ".exr") {
-    acquire::write_exr(path, linear, attributes);
+    imaging::write_exr(path, linear, attributes);
   } else if (e == ".png") {
-    acquire::write_png(path, tone_map(linear, options));
+    imaging::write_png(path, tone_map(linear, options));
   } else {
     throw Error(path.string() + ": output must be .png (tone-mapped) or .exr (linear)");
   }
 }
 
-float auto_exposure(const acquire::ImageRgb& linear, const std::vector<std::uint8_t>& mask) {
+float auto_exposure(const imaging::ImageRgb& linear, const std::vector<std::uint8_t>& mask) {
   std::vector<float> luminance;
   const std::size_t pixels = std::size_t(linear.width) * linear.height;
   for (std::size_t p = 0; p < pixels; ++p) {
@@ -67,7 +67,8 @@ float auto_exposure(const acquire::ImageRgb& linear, const std::vector<std::uint
     if (object && std::isfinite(y)) luminance.push_back(y);
   }
   if (luminance.empty()) return 1.0f;
-  const std::size_t k = std::min(luminance.size() - 1, std::size_t(0.95 * double(luminance.size())));
+  const std::size_t k =
+      std::min(luminance.size() - 1, std::size_t(0.95 * double(luminance.size())));
   std::nth_element(luminance.begin(), luminance.begin() + std::ptrdiff_t(k), luminance.end());
   const float p95 = luminance[k];
   return p95 > 0 ? 2.0f / p95 : 1.0f;

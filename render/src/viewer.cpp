@@ -28,10 +28,10 @@ Viewer::Viewer(const ViewerOptions& options)
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
-  window_ = glfwCreateWindow(options.scene.camera.width, options.scene.camera.height,
-                             ("lucent view - " + scene_.material.name + " on " + scene_.mesh.name)
-                                 .c_str(),
-                             nullptr, nullptr);
+  window_ = glfwCreateWindow(
+      options.scene.camera.width, options.scene.camera.height,
+      ("lucent view - " + scene_.material.name + " on " + scene_.mesh.name).c_str(), nullptr,
+      nullptr);
   if (window_ == nullptr) {
     throw Error("view: no OpenGL 4.5 core window (" + GlfwSession::last_error() + ")");
   }
@@ -43,7 +43,8 @@ Viewer::Viewer(const ViewerOptions& options)
     static_cast<Viewer*>(glfwGetWindowUserPointer(w))->scroll_ += float(dy);
   });
   glfwSetKeyCallback(window_, [](GLFWwindow* w, int key, int, int action, int) {
-    if (action == GLFW_PRESS) static_cast<Viewer*>(glfwGetWindowUserPointer(w))->keys_.push_back(key);
+    if (action == GLFW_PRESS)
+      static_cast<Viewer*>(glfwGetWindowUserPointer(w))->keys_.push_back(key);
   });
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
@@ -80,20 +81,20 @@ int Viewer::run() {
     // Frames as fast as they come while the maps accumulate or the mesh moves; otherwise wake for
     // input, a finished reference pass (the worker needs the CPU more than the window does) and,
     // now and then, to watch the material file.
-    const bool accumulating =
-        technique_ == "maps" && maps_ && (deformer_ || !maps_->converged());
+    const bool accumulating = technique_ == "maps" && maps_ && (deformer_ || !maps_->converged());
     if (accumulating) {
       glfwPollEvents();
     } else {
-      glfwWaitEventsTimeout(script_pos_ < script_.size() || technique_ == "reference" ? 0.05 : 0.25);
+      glfwWaitEventsTimeout(script_pos_ < script_.size() || technique_ == "reference" ? 0.05
+                                                                                      : 0.25);
     }
     frame();
   }
   std::printf(
       "view: %ld frames drawn, %d restarts, %d screenshots; technique %s, accumulated %d of %d "
       "frames\n",
-      frames_drawn_, restarts_, screenshots_, technique_.c_str(), maps_ ? maps_->accumulated_frames() : 0,
-      settings_.frames);
+      frames_drawn_, restarts_, screenshots_, technique_.c_str(),
+      maps_ ? maps_->accumulated_frames() : 0, settings_.frames);
   return 0;
 }
 
@@ -316,16 +317,24 @@ void Viewer::set_parameter(const std::string& name, const std::string& value) {
     set_deform(v);
   } else {
     RenderSettings next = settings_;
-    if (name == "N") next.samples = int(v);
-    else if (name == "M") next.disc_points = int(v);
-    else if (name == "q") next.q = v;
-    else if (name == "K") next.directions = int(v);
-    else if (name == "Ws") next.radiance_map_size = int(v);
-    else if (name == "Wl") next.light_map_size = int(v);
-    else if (name == "T") next.frames = int(v);
+    if (name == "N")
+      next.samples = int(v);
+    else if (name == "M")
+      next.disc_points = int(v);
+    else if (name == "q")
+      next.q = v;
+    else if (name == "K")
+      next.directions = int(v);
+    else if (name == "Ws")
+      next.radiance_map_size = int(v);
+    else if (name == "Wl")
+      next.light_map_size = int(v);
+    else if (name == "T")
+      next.frames = int(v);
     else
-      throw Error("--script: set " + name +
-                  ": expected N, M, q, K, Ws, Wl, T, exposure, size, deform, disc, technique or model");
+      throw Error(
+          "--script: set " + name +
+          ": expected N, M, q, K, Ws, Wl, T, exposure, size, deform, disc, technique or model");
     next.validate();
     settings_ = pending_ = next;
     rebuild_maps();
@@ -428,8 +437,9 @@ void Viewer::draw_difference() {
   glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT);
   if (reference_version_ != scene_version_ || cached_reference_.data.empty()) {
-    difference_text_ = "no reference for this view: switch to the CPU reference, let it run a "
-                       "pass, come back";
+    difference_text_ =
+        "no reference for this view: switch to the CPU reference, let it run a "
+        "pass, come back";
     maps_->present(settings_.exposure, width_, height_);
     return;
   }
@@ -444,7 +454,8 @@ void Viewer::draw_difference() {
         float sum = 0;
         for (int j = 0; j < fy; ++j)
           for (int i = 0; i < fx; ++i)
-            sum += full.at(std::min(full.width - 1, x * fx + i), std::min(full.height - 1, y * fy + j), c);
+            sum += full.at(std::min(full.width - 1, x * fx + i),
+                           std::min(full.height - 1, y * fy + j), c);
         small.at(x, y, c) = sum / float(fx * fy);
       }
   const auto mask = nonzero_mask(ref);
@@ -459,7 +470,11 @@ void Viewer::draw_difference() {
     ImageRgb diff(ref.width, ref.height, 0.0f);
     for (std::size_t p = 0; p < mask.size(); ++p)
       for (int c = 0; c < 3; ++c)
-        diff.data[3 * p + std::size_t(c)] = mask[p] ? float(std::abs(small.data[3 * p + std::size_t(c)] - ref.data[3 * p + std::size_t(c)]) / d.reference_mean) : 0.0f;
+        diff.data[3 * p + std::size_t(c)] =
+            mask[p] ? float(std::abs(small.data[3 * p + std::size_t(c)] -
+                                     ref.data[3 * p + std::size_t(c)]) /
+                            d.reference_mean)
+                    : 0.0f;
     blit(diff, 10.0f);  // 10 x the relative difference: white is 10% of the mean
   } catch (const Error& e) {
     difference_text_ = e.what();
@@ -471,7 +486,7 @@ void Viewer::blit(const ImageRgb& mean, float exposure) {
     // Tone-mapped on the CPU with the same curve as the maps' present(), then blitted.
     ToneMapOptions tone;
     tone.exposure = exposure;
-    const acquire::RawImage srgb = tone_map(mean, tone);
+    const imaging::RawImage srgb = tone_map(mean, tone);
     std::vector<std::uint8_t> rgb(srgb.data.size());
     const float to_byte = 255.0f / float(srgb.max_value);
     for (std::size_t i = 0; i < rgb.size(); ++i) {
@@ -493,8 +508,8 @@ void Viewer::blit(const ImageRgb& mean, float exposure) {
   }
   if (reference_fbo_ != 0) {
     // Row 0 of the image is the top: flip while blitting.
-    glBlitNamedFramebuffer(reference_fbo_, 0, 0, 0, reference_w_, reference_h_, 0, height_,
-                           width_, 0, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+    glBlitNamedFramebuffer(reference_fbo_, 0, 0, 0, reference_w_, reference_h_, 0, height_, width_,
+                           0, GL_COLOR_BUFFER_BIT, GL_LINEAR);
   }
 }
 
@@ -511,7 +526,7 @@ void Viewer::screenshot(const std::filesystem::path& path) {
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glReadBuffer(GL_BACK);
   glReadPixels(0, 0, width_, height_, GL_RGB, GL_UNSIGNED_BYTE, rgb.data());
-  acquire::RawImage image(width_, height_, 255);
+  imaging::RawImage image(width_, height_, 255);
   for (int y = 0; y < height_; ++y) {
     const std::size_t row = std::size_t(height_ - 1 - y) * std::size_t(width_) * 3;
     for (int x = 0; x < width_; ++x) {
@@ -519,7 +534,7 @@ void Viewer::screenshot(const std::filesystem::path& path) {
     }
   }
   try {
-    acquire::write_png(path, image);
+    imaging::write_png(path, image);
     commit_pending_outputs();  // a screenshot appears when taken, not when the viewer closes
     ++screenshots_;
     message_ = "wrote " + path.string();

@@ -2,7 +2,6 @@
 // worker thread, the GLFW session and the Viewer class. Private to lucent_viewer.
 #pragma once
 
-
 // clang-format off
 #include "gl_api.h"  // first: GLFW must not pull in the legacy GL header
 #define GLFW_INCLUDE_NONE
@@ -26,15 +25,15 @@
 #include <utility>
 #include <vector>
 
-#include "lucent/acquire/image_io.h"
+#include "lucent/imaging/image_io.h"
 #include "lucent/materials/error.h"
 #include "lucent/materials/material.h"
 #include "lucent/materials/profile_table.h"
 #include "lucent/render/radiance_maps.h"
 #include "lucent/render/tone_map.h"
 
-#include "lucent/render/viewer.h"
 #include "lucent/render/image_compare.h"
+#include "lucent/render/viewer.h"
 
 namespace lucent::render::viewer_detail {
 
@@ -286,7 +285,7 @@ class Viewer {
   bool show_difference_ = false;
   std::string difference_text_;
   long difference_frame_ = -1000;  // frame of the last printed difference
-  std::string message_;  // last error or notice, shown in the panel
+  std::string message_;            // last error or notice, shown in the panel
   std::vector<int> keys_;
   float scroll_ = 0;
   bool dragging_ = false;

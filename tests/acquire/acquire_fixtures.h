@@ -21,8 +21,8 @@
 #include "lucent/acquire/camera.h"
 #include "lucent/acquire/capture.h"
 #include "lucent/acquire/hdr_merge.h"
-#include "lucent/acquire/image_io.h"
 #include "lucent/acquire/profile.h"
+#include "lucent/imaging/image_io.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
 #include "raw_exr.h"
@@ -80,8 +80,8 @@ double spot_value(const Spot& s, int x, int y, int c) {
   return s.amplitude * kChannelScale[c] * falloff(r_mm);
 }
 
-ImageRgb spot_radiance(const Spot& s) {
-  ImageRgb image(s.width, s.height);
+imaging::ImageRgb spot_radiance(const Spot& s) {
+  imaging::ImageRgb image(s.width, s.height);
   for (int y = 0; y < s.height; ++y) {
     for (int x = 0; x < s.width; ++x) {
       for (int c = 0; c < 3; ++c) image.at(x, y, c) = float(spot_value(s, x, y, c));
@@ -91,9 +91,9 @@ ImageRgb spot_radiance(const Spot& s) {
 }
 
 // A camera without noise: code = round(encode(clamp(L t gain + offset, 0, 1)) max).
-RawImage exact_exposure(const ImageRgb& radiance, double t, double gain, int max_value,
-                        Response response, double offset = 0) {
-  RawImage out(radiance.width, radiance.height, max_value);
+imaging::RawImage exact_exposure(const imaging::ImageRgb& radiance, double t, double gain,
+                                 int max_value, Response response, double offset = 0) {
+  imaging::RawImage out(radiance.width, radiance.height, max_value);
   for (std::size_t i = 0; i < radiance.data.size(); ++i) {
     const double linear = std::clamp(radiance.data[i] * t * gain + offset, 0.0, 1.0);
     const double encoded = response == Response::kSrgb ? srgb_encode(linear) : linear;
@@ -110,13 +110,13 @@ struct StackSpec {
   double dark_offset = 0;  // linear, added to every bracket (and the dark frame, when written)
 };
 
-ImageSet write_brackets(const fs::path& dir, const std::string& stem, const ImageRgb& radiance,
-                        const StackSpec& spec) {
+ImageSet write_brackets(const fs::path& dir, const std::string& stem,
+                        const imaging::ImageRgb& radiance, const StackSpec& spec) {
   ImageSet set;
   for (std::size_t k = 0; k < spec.exposures_s.size(); ++k) {
     const std::string name = stem + "_" + std::to_string(k) + ".png";
-    write_png(dir / name, exact_exposure(radiance, spec.exposures_s[k], spec.gain, spec.max_value,
-                                         spec.response, spec.dark_offset));
+    imaging::write_png(dir / name, exact_exposure(radiance, spec.exposures_s[k], spec.gain,
+                                                  spec.max_value, spec.response, spec.dark_offset));
     set.images.push_back({name, spec.exposures_s[k]});
   }
   return set;
@@ -138,8 +138,9 @@ fs::path write_capture_file(const fs::path& dir, const Capture& capture,
 
 // A Lambertian reference of reflectance rho lit by a beam of power P: radiance P rho / pi times a
 // normalised Gaussian spot (per mm^2), point-sampled (sigma = 4 px, so the samples sum to 1).
-ImageRgb white_radiance(int size, double pitch_mm, double power, double rho, double sigma_mm) {
-  ImageRgb image(size, size);
+imaging::ImageRgb white_radiance(int size, double pitch_mm, double power, double rho,
+                                 double sigma_mm) {
+  imaging::ImageRgb image(size, size);
   for (int y = 0; y < size; ++y) {
     for (int x = 0; x < size; ++x) {
       const double r2 = std::pow(pitch_mm * (x + 0.5 - size / 2.0), 2) +
@@ -153,10 +154,10 @@ ImageRgb white_radiance(int size, double pitch_mm, double power, double rho, dou
 
 // An HdrResult holding `radiance` as measured, nothing masked, zero error: for the unit tests of
 // beam detection and binning.
-HdrResult as_measured(const ImageRgb& radiance) {
+HdrResult as_measured(const imaging::ImageRgb& radiance) {
   HdrResult hdr;
   hdr.radiance = radiance;
-  hdr.standard_error = ImageRgb(radiance.width, radiance.height, 0.0f);
+  hdr.standard_error = imaging::ImageRgb(radiance.width, radiance.height, 0.0f);
   hdr.mask.assign(radiance.data.size(), PixelMask::kValid);
   return hdr;
 }

@@ -211,7 +211,7 @@ TEST(Acquire, CalibratedProfileIsPiLOverBeamPower) {
     }
   }
   // The HDR image is radiance per unit power.
-  const ImageRgb exr = read_exr(out / "capture.exr");
+  const imaging::ImageRgb exr = imaging::read_exr(out / "capture.exr");
   for (int c = 0; c < 3; ++c) {
     EXPECT_NEAR(exr.at(10, 50, c), spot_value(s.spot, 10, 50, c) / s.power,
                 0.01 * spot_value(s.spot, 10, 50, c) / s.power);
@@ -343,7 +343,7 @@ TEST(Acquire, ExistingOutputFolderIsReplacedWholeOnlyWhenAllowed) {
   std::string header;
   std::getline(csv, header);
   EXPECT_EQ(header, "r_mm,R_r,R_g,R_b,se_r,se_g,se_b,n_r,n_g,n_b");
-  const RawImage png = read_raw_image(out / "acquire.png");
+  const imaging::RawImage png = imaging::read_raw_image(out / "acquire.png");
   EXPECT_GE(png.width, 512);
 }
 
@@ -363,8 +363,8 @@ TEST(AcquireBadInput, MismatchedImageSizes) {
   const ImageSet set = write_brackets(dir, "b", spot_radiance(Spot{}), StackSpec{});
   Spot small;
   small.height = 60;
-  write_png(dir / "b_1.png",
-            exact_exposure(spot_radiance(small), 4, 0.2, 65535, Response::kLinear));
+  imaging::write_png(dir / "b_1.png",
+                     exact_exposure(spot_radiance(small), 4, 0.2, 65535, Response::kLinear));
   expect_acquire_fails(write_capture_file(dir, make_capture(set, 0.1, Response::kLinear)),
                        dir / "out", {"b_1.png", "64x60", "64x64"});
 }
@@ -387,21 +387,21 @@ TEST(AcquireBadInput, DuplicateExposures) {
 
 TEST(AcquireBadInput, AllSaturatedStack) {
   const fs::path dir = scratch_dir("bad-saturated");
-  const ImageSet set = write_brackets(dir, "b", ImageRgb(64, 64, 100.0f), StackSpec{});
+  const ImageSet set = write_brackets(dir, "b", imaging::ImageRgb(64, 64, 100.0f), StackSpec{});
   expect_acquire_fails(write_capture_file(dir, make_capture(set, 0.1, Response::kLinear)),
                        dir / "out", {"all-saturated", "b_0.png"});
 }
 
 TEST(AcquireBadInput, AllBlackStack) {
   const fs::path dir = scratch_dir("bad-black");
-  const ImageSet set = write_brackets(dir, "b", ImageRgb(64, 64, 0.0f), StackSpec{});
+  const ImageSet set = write_brackets(dir, "b", imaging::ImageRgb(64, 64, 0.0f), StackSpec{});
   expect_acquire_fails(write_capture_file(dir, make_capture(set, 0.1, Response::kLinear)),
                        dir / "out", {"all-black", "b_0.png"});
 }
 
 TEST(AcquireBadInput, NoBeamFound) {
   const fs::path dir = scratch_dir("bad-flat");
-  const ImageSet set = write_brackets(dir, "b", ImageRgb(64, 64, 0.05f), StackSpec{});
+  const ImageSet set = write_brackets(dir, "b", imaging::ImageRgb(64, 64, 0.05f), StackSpec{});
   expect_acquire_fails(write_capture_file(dir, make_capture(set, 0.1, Response::kLinear)),
                        dir / "out", {"no beam found", "b_0.png"});
 }
@@ -426,7 +426,7 @@ TEST(AcquireBadInput, UnreadableExr) {
 
 TEST(AcquireBadInput, NonFinitePixelsAreMaskedAndReportedUnlessEveryPixelIs) {
   const fs::path dir = scratch_dir("bad-nan");
-  ImageRgb image = spot_radiance(Spot{});
+  imaging::ImageRgb image = spot_radiance(Spot{});
   for (int x = 0; x < 6; ++x) image.at(x, 60, 1) = std::numeric_limits<float>::quiet_NaN();
   image.at(50, 10, 0) = std::numeric_limits<float>::infinity();
   lucent::testing::write_raw_exr(dir / "sample.exr", image);  // NaN on purpose
@@ -439,8 +439,8 @@ TEST(AcquireBadInput, NonFinitePixelsAreMaskedAndReportedUnlessEveryPixelIs) {
   EXPECT_EQ(profile.masked.non_finite, (std::array<std::int64_t, 3>{1, 6, 0}));
   EXPECT_NEAR(summary.beam_point_px[0], 30.3, 0.05);
 
-  lucent::testing::write_raw_exr(dir / "nan.exr",
-                                 ImageRgb(64, 64, std::numeric_limits<float>::quiet_NaN()));
+  lucent::testing::write_raw_exr(
+      dir / "nan.exr", imaging::ImageRgb(64, 64, std::numeric_limits<float>::quiet_NaN()));
   set.hdr = "nan.exr";
   expect_acquire_fails(
       write_capture_file(dir, make_capture(set, 0.1, Response::kLinear), "nan.json"),
@@ -452,7 +452,7 @@ TEST(AcquireBadInput, FailureLeavesAnExistingOutputFolderUnchanged) {
   const fs::path out = dir / "out";
   fs::create_directories(out);
   std::ofstream(out / "profile.json") << "{\"keep\": true}";
-  const ImageSet set = write_brackets(dir, "b", ImageRgb(64, 64, 0.0f), StackSpec{});
+  const ImageSet set = write_brackets(dir, "b", imaging::ImageRgb(64, 64, 0.0f), StackSpec{});
   set_replace_folders(true);  // allowed to replace it, but the run fails: the folder must survive
   expect_acquire_fails(write_capture_file(dir, make_capture(set, 0.1, Response::kLinear)), out,
                        {"all-black"});

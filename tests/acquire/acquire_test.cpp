@@ -16,7 +16,7 @@ using nlohmann::json;
 TEST(HdrMerge, LinearStackRecoversRadianceWithinQuantisation) {
   const fs::path dir = scratch_dir("merge-linear");
   const Spot spot;
-  const ImageRgb truth = spot_radiance(spot);
+  const imaging::ImageRgb truth = spot_radiance(spot);
   const StackSpec spec;
   const ImageSet set = write_brackets(dir, "b", truth, spec);
   const HdrResult hdr = merge_brackets(set, Response::kLinear, std::nullopt, dir);
@@ -45,7 +45,7 @@ TEST(HdrMerge, LinearStackRecoversRadianceWithinQuantisation) {
 
 TEST(HdrMerge, SrgbResponseRoundTrip) {
   const fs::path dir = scratch_dir("merge-srgb");
-  const ImageRgb truth = spot_radiance(Spot{});
+  const imaging::ImageRgb truth = spot_radiance(Spot{});
   for (int max_value : {255, 65535}) {
     StackSpec spec;
     spec.response = Response::kSrgb;
@@ -80,11 +80,11 @@ TEST(HdrMerge, PixelsSaturatedInEveryBracketAreMaskedNotGuessed) {
   const fs::path dir = scratch_dir("merge-saturated");
   Spot spot;
   spot.amplitude = 8;
-  const ImageRgb truth = spot_radiance(spot);
+  const imaging::ImageRgb truth = spot_radiance(spot);
   const StackSpec spec;
   const ImageSet set = write_brackets(dir, "b", truth, spec);
   const HdrResult hdr = merge_brackets(set, Response::kLinear, std::nullopt, dir);
-  const RawImage shortest =
+  const imaging::RawImage shortest =
       exact_exposure(truth, spec.exposures_s.front(), spec.gain, 65535, Response::kLinear);
   std::array<std::int64_t, 3> expected{};
   for (std::size_t i = 0; i < truth.data.size(); ++i) {
@@ -106,7 +106,7 @@ TEST(HdrMerge, PixelsSaturatedInEveryBracketAreMaskedNotGuessed) {
 
 TEST(HdrMerge, PixelsBlackInEveryBracketAreMasked) {
   const fs::path dir = scratch_dir("merge-black");
-  ImageRgb truth = spot_radiance(Spot{});
+  imaging::ImageRgb truth = spot_radiance(Spot{});
   for (int y = 0; y < 5; ++y) {  // a dark 10x5 strip, blue channel only for half of it
     for (int x = 0; x < 10; ++x) {
       for (int c = x < 5 ? 0 : 2; c < 3; ++c) truth.at(x, y, c) = 0.0f;
@@ -123,15 +123,15 @@ TEST(HdrMerge, PixelsBlackInEveryBracketAreMasked) {
 
 TEST(HdrMerge, DarkFrameIsSubtractedBeforeDividingByExposure) {
   const fs::path dir = scratch_dir("merge-dark");
-  ImageRgb truth = spot_radiance(Spot{});
+  imaging::ImageRgb truth = spot_radiance(Spot{});
   // At the dark level: a measurement of no light (valid, ~0), not censored. Masking such pixels
   // kept only those that noise lifted above the dark level: a floor in faint profiles.
   truth.at(0, 0, 0) = truth.at(0, 0, 1) = truth.at(0, 0, 2) = 0.0f;
   StackSpec spec;
   spec.dark_offset = 0.01;  // a black level of 1% of the range in every bracket
   const ImageSet set = write_brackets(dir, "b", truth, spec);
-  write_png(dir / "dark.png", exact_exposure(ImageRgb(64, 64, 0.0f), 1, spec.gain, 65535,
-                                             Response::kLinear, spec.dark_offset));
+  imaging::write_png(dir / "dark.png", exact_exposure(imaging::ImageRgb(64, 64, 0.0f), 1, spec.gain,
+                                                      65535, Response::kLinear, spec.dark_offset));
   const HdrResult with_dark = merge_brackets(set, Response::kLinear, fs::path("dark.png"), dir);
   const HdrResult without = merge_brackets(set, Response::kLinear, std::nullopt, dir);
   EXPECT_EQ(with_dark.mask_at(0, 0, 1), PixelMask::kValid);
@@ -152,21 +152,21 @@ TEST(HdrMerge, StandardErrorMatchesTheActualScatter) {
   // the fitted model must recover the gain, and (merged - truth) / standard error must have unit
   // spread.
   const fs::path dir = scratch_dir("merge-noise");
-  const ImageRgb truth = spot_radiance(Spot{});
+  const imaging::ImageRgb truth = spot_radiance(Spot{});
   const double full_well = 40000, read_e = 4, gain = 0.2;
   const std::vector<double> exposures = {1, 4, 16, 64};
   std::mt19937_64 rng(7);
   std::normal_distribution<double> gauss(0, 1);
   ImageSet set;
   for (std::size_t k = 0; k < exposures.size(); ++k) {
-    RawImage image(64, 64, 65535);
+    imaging::RawImage image(64, 64, 65535);
     for (std::size_t i = 0; i < truth.data.size(); ++i) {
       const double electrons = truth.data[i] * exposures[k] * gain * full_well;
       const double noisy = electrons + std::sqrt(electrons + read_e * read_e) * gauss(rng);
       image.data[i] = std::uint16_t(std::lround(std::clamp(noisy / full_well, 0.0, 1.0) * 65535));
     }
     const std::string name = "n" + std::to_string(k) + ".png";
-    write_png(dir / name, image);
+    imaging::write_png(dir / name, image);
     set.images.push_back({name, exposures[k]});
   }
   const HdrResult hdr = merge_brackets(set, Response::kLinear, std::nullopt, dir);
@@ -188,17 +188,17 @@ TEST(HdrMerge, StandardErrorMatchesTheActualScatter) {
 TEST(HdrMerge, CalibratedResponseRecoversRadianceUpToScale) {
   // An 8-bit camera with a gamma-2.2 response that the merge is not told about.
   const fs::path dir = scratch_dir("merge-calibrate");
-  const ImageRgb truth = spot_radiance(Spot{});
+  const imaging::ImageRgb truth = spot_radiance(Spot{});
   const std::vector<double> exposures = {0.25, 1, 4, 16, 64};
   ImageSet set;
   for (std::size_t k = 0; k < exposures.size(); ++k) {
-    RawImage image(64, 64, 255);
+    imaging::RawImage image(64, 64, 255);
     for (std::size_t i = 0; i < truth.data.size(); ++i) {
       const double linear = std::clamp(truth.data[i] * exposures[k] * 0.2, 0.0, 1.0);
       image.data[i] = std::uint16_t(std::lround(std::pow(linear, 1 / 2.2) * 255));
     }
     const std::string name = "g" + std::to_string(k) + ".png";
-    write_png(dir / name, image);
+    imaging::write_png(dir / name, image);
     set.images.push_back({name, exposures[k]});
   }
   const HdrResult hdr = merge_brackets(set, Response::kCalibrate, std::nullopt, dir);
@@ -230,7 +230,7 @@ TEST(HdrMerge, CalibrateRejectsSixteenBitBrackets) {
 
 TEST(HdrMerge, HdrInputMasksNonFinitePixels) {
   const fs::path dir = scratch_dir("merge-hdr");
-  ImageRgb image = spot_radiance(Spot{});
+  imaging::ImageRgb image = spot_radiance(Spot{});
   image.at(3, 4, 0) = std::numeric_limits<float>::quiet_NaN();
   image.at(5, 6, 1) = std::numeric_limits<float>::infinity();
   image.at(7, 8, 2) = -std::numeric_limits<float>::infinity();
@@ -294,7 +294,7 @@ TEST(BeamPoint, UnresolvedSpikeDoesNotPinTheCentroid) {
     Spot spot;
     spot.cx = cx;
     spot.cy = cy;
-    ImageRgb image = spot_radiance(spot);
+    imaging::ImageRgb image = spot_radiance(spot);
     for (int c = 0; c < 3; ++c) image.at(int(cx), int(cy), c) *= 10;
     const BeamPoint beam = find_beam_point(as_measured(image), "spike");
     EXPECT_TRUE(beam.spike_capped);
@@ -305,18 +305,18 @@ TEST(BeamPoint, UnresolvedSpikeDoesNotPinTheCentroid) {
   never.spike_ratio = 0;
   Spot corner;
   corner.cx = corner.cy = 32.0;
-  ImageRgb image = spot_radiance(corner);
+  imaging::ImageRgb image = spot_radiance(corner);
   for (int c = 0; c < 3; ++c) image.at(32, 32, c) *= 10;
   EXPECT_NEAR(find_beam_point(as_measured(image), "spike", never).px[0], 32.5, 1e-9);
 }
 
 TEST(BeamPoint, FlatImageHasNoBeam) {
-  ImageRgb flat(64, 64, 1.0f);
+  imaging::ImageRgb flat(64, 64, 1.0f);
   std::mt19937_64 rng(3);
   std::normal_distribution<float> gauss(0, 0.01f);
   for (float& v : flat.data) v += gauss(rng);
   EXPECT_THROW(find_beam_point(as_measured(flat), "flat"), Error);
-  EXPECT_THROW(find_beam_point(as_measured(ImageRgb(64, 64, 1.0f)), "flat"), Error);
+  EXPECT_THROW(find_beam_point(as_measured(imaging::ImageRgb(64, 64, 1.0f)), "flat"), Error);
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -349,7 +349,7 @@ TEST(RadialBinning, LinearAndLogEdges) {
 TEST(RadialBinning, CountsRangesAndValues) {
   // A uniform image around (32, 32) px: each bin's count is the number of pixel centres in its
   // annulus, its value the uniform value, its r_mm the mean distance of those centres.
-  HdrResult hdr = as_measured(ImageRgb(64, 64, 2.0f));
+  HdrResult hdr = as_measured(imaging::ImageRgb(64, 64, 2.0f));
   hdr.mask[(std::size_t(32) * 64 + 33) * 3 + 1] = PixelMask::kSaturated;  // one masked pixel, green
   RadialBinning binning;
   binning.bins = 20;

@@ -21,12 +21,12 @@ TEST(Camera, NoiseFreeExposureIsLinearInRadianceAndTime) {
   o.response = Response::kLinear;
   o.bits = 16;
   o.black_level_e = 0;
-  ImageRgb radiance(4, 1);
+  imaging::ImageRgb radiance(4, 1);
   for (int x = 0; x < 4; ++x) {
     for (int c = 0; c < 3; ++c) radiance.at(x, 0, c) = float(x + 1);
   }
   const double scale = 1000.0;  // electrons per radiance second
-  const RawImage image = expose(radiance, 2.0, scale, o, 0);
+  const imaging::RawImage image = expose(radiance, 2.0, scale, o, 0);
   for (int x = 0; x < 4; ++x) {
     const double expected = (x + 1) * 2.0 * scale / o.full_well_e * 65535;
     EXPECT_NEAR(image.at(x, 0, 1), expected, 0.5);
@@ -38,9 +38,9 @@ TEST(Camera, SaturatesAndQuantisesTo8Bits) {
   o.noise = false;
   o.bits = 8;
   o.response = Response::kSrgb;
-  ImageRgb radiance(2, 1);
+  imaging::ImageRgb radiance(2, 1);
   radiance.at(0, 0, 0) = 1e9f;
-  const RawImage image = expose(radiance, 1.0, 1.0, o, 0);
+  const imaging::RawImage image = expose(radiance, 1.0, 1.0, o, 0);
   EXPECT_EQ(image.max_value, 255);
   EXPECT_EQ(image.at(0, 0, 0), 255);
   // A black pixel reads the black level only.
@@ -53,8 +53,8 @@ TEST(Camera, ShotNoiseHasPoissonVariance) {
   o.read_noise_e = 0;
   o.black_level_e = 0;
   o.full_well_e = 65535;  // one code value per electron
-  ImageRgb radiance(200, 200, 100.0f);
-  const RawImage image = expose(radiance, 1.0, 1.0, o, 3);  // 100 electrons expected
+  imaging::ImageRgb radiance(200, 200, 100.0f);
+  const imaging::RawImage image = expose(radiance, 1.0, 1.0, o, 3);  // 100 electrons expected
   double sum = 0, sum2 = 0;
   for (auto v : image.data) {
     sum += v;
@@ -68,10 +68,10 @@ TEST(Camera, ShotNoiseHasPoissonVariance) {
 
 TEST(Camera, StreamsAreDeterministicAndDistinct) {
   CameraOptions o;
-  ImageRgb radiance(16, 16, 50.0f);
-  const RawImage a = expose(radiance, 1.0, 10.0, o, 1);
-  const RawImage b = expose(radiance, 1.0, 10.0, o, 1);
-  const RawImage c = expose(radiance, 1.0, 10.0, o, 2);
+  imaging::ImageRgb radiance(16, 16, 50.0f);
+  const imaging::RawImage a = expose(radiance, 1.0, 10.0, o, 1);
+  const imaging::RawImage b = expose(radiance, 1.0, 10.0, o, 1);
+  const imaging::RawImage c = expose(radiance, 1.0, 10.0, o, 2);
   EXPECT_EQ(a.data, b.data);
   EXPECT_NE(a.data, c.data);
 }

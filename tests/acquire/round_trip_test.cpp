@@ -6,8 +6,8 @@
 #include <numbers>
 
 #include "lucent/acquire/acquire.h"
-#include "lucent/acquire/image_io.h"
 #include "lucent/acquire/simulate.h"
+#include "lucent/imaging/image_io.h"
 
 namespace lucent::acquire {
 namespace {
@@ -27,14 +27,14 @@ struct BinnedTruth {
   double sum = 0, se2 = 0;
   int n = 0;
 };
-BinnedTruth bin_truth(const Profile& profile, std::size_t b, int c, const ImageRgb& truth,
-                      const ImageRgb* truth_se) {
+BinnedTruth bin_truth(const Profile& profile, std::size_t b, int c, const imaging::ImageRgb& truth,
+                      const imaging::ImageRgb* truth_se) {
   BinnedTruth t;
   const bool last = b + 1 == profile.radial.size();
   for (int j = 0; j < truth.height; ++j) {
     for (int i = 0; i < truth.width; ++i) {
-      const double r = 0.25 * std::hypot(i + 0.5 - profile.beam_point_px[0],
-                                         j + 0.5 - profile.beam_point_px[1]);
+      const double r =
+          0.25 * std::hypot(i + 0.5 - profile.beam_point_px[0], j + 0.5 - profile.beam_point_px[1]);
       if (r >= profile.radial.r_inner_mm[b] &&
           (r < profile.radial.r_outer_mm[b] || (last && r <= profile.radial.r_outer_mm[b]))) {
         t.sum += truth.at(i, j, c);
@@ -68,7 +68,7 @@ TEST(RoundTrip, SimulateThenAcquireRecoversTheRadianceInAbsoluteUnits) {
   // The truth binned exactly as acquire bins the measurement: pi times the mean radiance of the
   // pixels whose centres fall in each bin.
   const Profile profile = read_profile(acq / "profile.json");
-  const ImageRgb truth = read_exr(sim / "truth_radiance.exr");
+  const imaging::ImageRgb truth = imaging::read_exr(sim / "truth_radiance.exr");
   int bins = 0, within = 0;
   for (std::size_t b = 0; b < profile.radial.size(); ++b) {
     for (int c = 0; c < 3; ++c) {
@@ -90,7 +90,6 @@ TEST(RoundTrip, SimulateThenAcquireRecoversTheRadianceInAbsoluteUnits) {
   fs::remove_all(acq);
 }
 
-
 // The faint tail without bias (no floor from dark subtraction, censoring or noise-dependent
 // weights): every bin of a 0.25 mm capture against the truth averaged over the same pixels, the
 // truth's own Monte Carlo error and the calibration's in the standard error.
@@ -110,8 +109,8 @@ TEST_P(ProfileWithoutBias, EveryBinAgreesWithTheTruthDownToTheNoise) {
   const AcquireSummary summary = run_acquire(sim / "capture.json", acq, AcquireOptions{});
   ASSERT_TRUE(summary.calibrated);
   const Profile profile = read_profile(acq / "profile.json");
-  const ImageRgb truth = read_exr(sim / "truth_radiance.exr");
-  const ImageRgb truth_se = read_exr(sim / "truth_radiance_se.exr");
+  const imaging::ImageRgb truth = imaging::read_exr(sim / "truth_radiance.exr");
+  const imaging::ImageRgb truth_se = imaging::read_exr(sim / "truth_radiance_se.exr");
   int bins = 0, within3 = 0, tail = 0;
   double worst = 0, tail_z = 0;
   for (std::size_t b = 0; b < profile.radial.size(); ++b) {

@@ -7,7 +7,7 @@
 #include <numbers>
 
 #include "lucent/acquire/capture.h"
-#include "lucent/acquire/image_io.h"
+#include "lucent/imaging/image_io.h"
 #include "lucent/materials/error.h"
 
 namespace lucent::acquire {
@@ -33,7 +33,7 @@ SimulateOptions small_marble() {
 }
 
 TEST(WhiteReference, IntegratesToReflectanceOverPi) {
-  const ImageRgb white = white_reference_radiance(64, 0.1, 0.99, 0.1);
+  const imaging::ImageRgb white = white_reference_radiance(64, 0.1, 0.99, 0.1);
   double sum = 0;
   for (int j = 0; j < 64; ++j) {
     for (int i = 0; i < 64; ++i) sum += white.at(i, j, 0) * 0.01;
@@ -54,11 +54,11 @@ TEST(Simulate, WritesACaptureThatReadsBack) {
   EXPECT_DOUBLE_EQ(capture.pixel_pitch_mm, 0.2);
   EXPECT_EQ(capture.response, Response::kSrgb);
   for (const Bracket& b : capture.sample.images) {
-    const RawImage raw = read_raw_image(dir / b.path);
+    const imaging::RawImage raw = imaging::read_raw_image(dir / b.path);
     EXPECT_EQ(raw.width, 32);
     EXPECT_EQ(raw.max_value, 65535);
   }
-  const ImageRgb truth = read_exr(dir / "truth_radiance.exr");
+  const imaging::ImageRgb truth = imaging::read_exr(dir / "truth_radiance.exr");
   EXPECT_EQ(truth.width, 32);
   EXPECT_GT(truth.at(16, 16, 0), truth.at(2, 2, 0));
   std::ifstream in(dir / "truth.json");

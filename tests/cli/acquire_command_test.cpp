@@ -9,13 +9,14 @@
 
 #include "cli_runner.h"
 #include "lucent/acquire/capture.h"
-#include "lucent/acquire/image_io.h"
+#include "lucent/imaging/image_io.h"
 
 namespace lucent::testing {
 namespace {
 
 namespace fs = std::filesystem;
 using namespace lucent::acquire;
+using namespace lucent::imaging;
 
 // Three 16-bit linear brackets of a spot at (30.3, 33.7) px, L = exp(-r / 2 mm) / (r + 0.5 mm).
 fs::path write_capture_folder(const fs::path& dir) {

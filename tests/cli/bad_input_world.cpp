@@ -6,7 +6,7 @@
 #include <cstring>
 
 #include "bad_input.h"
-#include "lucent/acquire/image_io.h"
+#include "lucent/imaging/image_io.h"
 
 namespace lucent::testing {
 namespace {
@@ -59,15 +59,16 @@ fs::path make_world_in(const fs::path& w, const fs::path& final) {
   fs::copy_file(src / "tests/cli/data/configs.csv", w / "configs.csv");
   for (const char* mesh : {"cube_ascii.ply", "cube_binary.ply", "cube.obj"})
     fs::copy_file(src / "fuzz/seeds/mesh" / mesh, w / mesh);
-  acquire::ImageRgb env(16, 8, 0.5f);
-  acquire::write_exr(w / "env.exr", env);
+  imaging::ImageRgb env(16, 8, 0.5f);
+  imaging::write_exr(w / "env.exr", env);
   write_hdr(w / "env.hdr", 16, 8, 0.5f);
   return w;
 }
 
 fs::path make_world() {
   const auto stamp = fs::last_write_time(LUCENT_BINARY).time_since_epoch().count();
-  const fs::path w = fs::temp_directory_path() / ("lucent-bad-input-world-" + std::to_string(stamp));
+  const fs::path w =
+      fs::temp_directory_path() / ("lucent-bad-input-world-" + std::to_string(stamp));
   if (fs::exists(w / "complete")) return w;
   const fs::path mine = w.string() + ".building-" + std::to_string(::getpid());
   fs::remove_all(mine);

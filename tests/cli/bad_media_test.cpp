@@ -11,7 +11,7 @@
 #include <limits>
 
 #include "bad_input.h"
-#include "lucent/acquire/image_io.h"
+#include "lucent/imaging/image_io.h"
 #include "raw_exr.h"
 
 namespace lucent::testing {
@@ -21,8 +21,8 @@ namespace {
 
 // An EXR with any values, NaN included (lucent's own writer refuses non-finite pixels).
 void write_exr_with(const fs::path& path, int w, int h, float value, float special = 0,
-                   bool with_special = false) {
-  acquire::ImageRgb image(w, h, value);
+                    bool with_special = false) {
+  imaging::ImageRgb image(w, h, value);
   if (with_special) image.data[3 * (std::size_t(w) * h / 2)] = special;
   lucent::testing::write_raw_exr(path, image);
 }
@@ -33,9 +33,9 @@ std::function<void(const fs::path&)> exr_file(std::string name, float value, flo
 }
 
 void write_png_of(const fs::path& path, int w, int h, int max, std::uint16_t value) {
-  acquire::RawImage image(w, h, max);
+  imaging::RawImage image(w, h, max);
   for (auto& v : image.data) v = value;
-  acquire::write_png(path, image);
+  imaging::write_png(path, image);
 }
 
 std::uint32_t crc32(const std::string& bytes) {
@@ -66,14 +66,17 @@ std::function<void(const fs::path&)> capture_with(std::string which,
     make(d / "img.png");
     Json c = read_json(world() / "capture_abs.json");
     const std::string path = (d / "img.png").string();
-    if (which == "dark") c["dark"] = path;
-    else if (which == "white") c["white_reference"]["images"][1]["path"] = path;
+    if (which == "dark")
+      c["dark"] = path;
+    else if (which == "white")
+      c["white_reference"]["images"][1]["path"] = path;
     else if (which == "all") {
       for (auto& image : c["images"]) image["path"] = path;
       c.erase("dark");
       c.erase("white_reference");
       c["images"] = Json::array({c["images"][0]});
-    } else c["images"][2]["path"] = path;
+    } else
+      c["images"][2]["path"] = path;
     write_file(d / "c.json", c.dump(2));
   };
 }
@@ -133,14 +136,13 @@ std::vector<BadCase> bracket_cases() {
                     }),
        args, "img.png"},
       {"bracket_directory",
-       capture_with("image", [](const fs::path& p) { fs::create_directory(p); }), args,
-       "img.png"},
+       capture_with("image", [](const fs::path& p) { fs::create_directory(p); }), args, "img.png"},
       {"bracket_all_black",
        capture_with("all", [](const fs::path& p) { write_png_of(p, 64, 64, 65535, 0); }), args,
        "all-black"},
       {"bracket_all_saturated",
-       capture_with("all", [](const fs::path& p) { write_png_of(p, 64, 64, 65535, 65535); }),
-       args, "all-saturated"},
+       capture_with("all", [](const fs::path& p) { write_png_of(p, 64, 64, 65535, 65535); }), args,
+       "all-saturated"},
       {"dark_text", capture_with("dark", bytes_at("dark\n")), args, "img.png"},
       {"dark_other_size",
        capture_with("dark", [](const fs::path& p) { write_png_of(p, 8, 8, 65535, 0); }), args,
@@ -158,8 +160,9 @@ std::vector<BadCase> bracket_cases() {
 // ---- OpenEXR and Radiance images (compare, --env, capture hdr) ----------------------------------
 std::vector<BadCase> image_cases() {
   const std::string cmp = "compare {dir}/a.exr {world}/env.exr --json";
-  const std::string env = "render --material marble --mesh sphere --technique reference --size 8x8 "
-                          "--samples-pixel 1 -o {dir}/out.exr --env ";
+  const std::string env =
+      "render --material marble --mesh sphere --technique reference --size 8x8 "
+      "--samples-pixel 1 -o {dir}/out.exr --env ";
   return {
       {"exr_missing", nullptr, cmp, "a.exr"},
       {"exr_text", bytes_file("a.exr", "hello"), cmp, "a.exr"},
@@ -170,10 +173,9 @@ std::vector<BadCase> image_cases() {
          write_file(d / "a.exr", b.substr(0, b.size() / 2));
        },
        cmp, "a.exr"},
-      {"exr_directory", [](const fs::path& d) { fs::create_directory(d / "a.exr"); }, cmp,
-       "a.exr"},
-      {"exr_size_mismatch", [](const fs::path& d) { write_exr_with(d / "a.exr", 8, 8, 0.5f); },
-       cmp, "size"},
+      {"exr_directory", [](const fs::path& d) { fs::create_directory(d / "a.exr"); }, cmp, "a.exr"},
+      {"exr_size_mismatch", [](const fs::path& d) { write_exr_with(d / "a.exr", 8, 8, 0.5f); }, cmp,
+       "size"},
       {"env_nan", exr_file("e.exr", 0.5f, std::nanf(""), true), env + "{dir}/e.exr", "e.exr"},
       {"env_inf", exr_file("e.exr", 0.5f, INFINITY, true), env + "{dir}/e.exr", "e.exr"},
       {"env_1e38", exr_file("e.exr", 1e38f), env + "{dir}/e.exr", "e.exr"},
@@ -193,23 +195,22 @@ std::vector<BadCase> image_cases() {
        "render --material marble --mesh sphere --technique reference --size 8x8 "
        "--samples-pixel 1 --env {dir}/e.exr -o {dir}/e.exr",
        "is an input"},
-      {"exr_reference_missing", [](const fs::path& d) { fs::copy_file(world() / "env.exr", d / "a.exr"); },
+      {"exr_reference_missing",
+       [](const fs::path& d) { fs::copy_file(world() / "env.exr", d / "a.exr"); },
        "compare {dir}/a.exr {dir}/none.exr", "none.exr"},
       {"exr_reference_text", bytes_file("r.exr", "text"), "compare {world}/env.exr {dir}/r.exr",
        "r.exr"},
       {"exr_no_rgb_channels", [](const fs::path& d) { write_z_only_exr(d / "a.exr"); }, cmp,
        "neither R, G, B nor Y"},
       {"exr_dev_zero", nullptr, "compare /dev/zero {world}/env.exr", "/dev/zero"},
-      {"exr_hdr_given_to_compare", [](const fs::path& d) { fs::copy_file(world() / "env.hdr", d / "a.exr"); },
-       cmp, "a.exr"},
+      {"exr_hdr_given_to_compare",
+       [](const fs::path& d) { fs::copy_file(world() / "env.hdr", d / "a.exr"); }, cmp, "a.exr"},
       {"capture_hdr_missing", capture_hdr(nullptr), "acquire {dir}/c.json -o {dir}/out", "h.exr"},
-      {"capture_hdr_all_nan",
-       capture_hdr([](const fs::path& p) {
-         write_raw_exr(p, acquire::ImageRgb(32, 32, std::nanf("")));
+      {"capture_hdr_all_nan", capture_hdr([](const fs::path& p) {
+         write_raw_exr(p, imaging::ImageRgb(32, 32, std::nanf("")));
        }),
        "acquire {dir}/c.json -o {dir}/out", "no finite pixels"},
-      {"capture_hdr_truncated",
-       capture_hdr([](const fs::path& p) {
+      {"capture_hdr_truncated", capture_hdr([](const fs::path& p) {
          const std::string b = read_bytes(world() / "env.exr");
          write_file(p, b.substr(0, b.size() - 20));
        }),
@@ -218,7 +219,8 @@ std::vector<BadCase> image_cases() {
       {"env_directory", [](const fs::path& d) { fs::create_directory(d / "e.exr"); },
        env + "{dir}/e.exr", "e.exr"},
       {"env_dev_zero", nullptr, env + "/dev/zero", "/dev/zero"},
-      {"env_hdr_header_only", bytes_file("e.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8 +X 16\n"),
+      {"env_hdr_header_only",
+       bytes_file("e.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8 +X 16\n"),
        env + "{dir}/e.hdr", "e.hdr"},
       {"env_exr_text", bytes_file("e.exr", "not an exr"), env + "{dir}/e.exr", "e.exr"},
       {"compare_difference_overwrites_input",
@@ -229,8 +231,9 @@ std::vector<BadCase> image_cases() {
 
 // ---- PLY / OBJ meshes (render --mesh) -----------------------------------------------------------
 std::vector<BadCase> mesh_cases() {
-  const std::string pre = "render --material marble --technique reference --size 8x8 "
-                          "--samples-pixel 1 -o {dir}/out.exr --mesh ";
+  const std::string pre =
+      "render --material marble --technique reference --size 8x8 "
+      "--samples-pixel 1 -o {dir}/out.exr --mesh ";
   const auto from_world = [](std::string seed, std::string name,
                              std::function<std::string(std::string)> edit) {
     return [=](const fs::path& d) { write_file(d / name, edit(read_bytes(world() / seed))); };
@@ -240,7 +243,8 @@ std::vector<BadCase> mesh_cases() {
   };
   return {
       {"ply_binary_one_byte_short",
-       from_world("cube_binary.ply", "m.ply", [](std::string s) { return s.substr(0, s.size() - 1); }),
+       from_world("cube_binary.ply", "m.ply",
+                  [](std::string s) { return s.substr(0, s.size() - 1); }),
        pre + "{dir}/m.ply", "m.ply"},
       {"ply_huge_vertex_count",
        from_world("cube_binary.ply", "m.ply", sub("element vertex 8", "element vertex 2000000000")),
@@ -252,15 +256,14 @@ std::vector<BadCase> mesh_cases() {
        "out of range"},
       {"ply_not_ply", bytes_file("m.ply", "solid x\n"), pre + "{dir}/m.ply", "not a PLY"},
       {"ply_empty", bytes_file("m.ply", ""), pre + "{dir}/m.ply", "m.ply"},
-      {"ply_no_end_header",
-       from_world("cube_ascii.ply", "m.ply", sub("end_header", "end_headers")),
+      {"ply_no_end_header", from_world("cube_ascii.ply", "m.ply", sub("end_header", "end_headers")),
        pre + "{dir}/m.ply", "m.ply"},
       {"ply_no_faces",
        from_world("cube_ascii.ply", "m.ply",
                   [](std::string s) { return s.substr(0, s.find("4 0 1 3 2")); }),
        pre + "{dir}/m.ply", "m.ply"},
-      {"obj_nan", from_world("cube.obj", "m.obj", sub("v 0 0 0", "v nan 0 0")),
-       pre + "{dir}/m.obj", "not finite"},
+      {"obj_nan", from_world("cube.obj", "m.obj", sub("v 0 0 0", "v nan 0 0")), pre + "{dir}/m.obj",
+       "not finite"},
       {"obj_index_zero", from_world("cube.obj", "m.obj", sub("f 1/1/1", "f 0/1/1")),
        pre + "{dir}/m.obj", "vertex index"},
       {"obj_out_of_range", from_world("cube.obj", "m.obj", sub("f 1/1/1", "f 50/1/1")),
@@ -271,9 +274,8 @@ std::vector<BadCase> mesh_cases() {
       {"mesh_directory", [](const fs::path& d) { fs::create_directory(d / "m.ply"); },
        pre + "{dir}/m.ply", "m.ply"},
       {"mesh_stl", bytes_file("m.stl", "solid x\n"), pre + "{dir}/m.stl", "unsupported"},
-      {"mesh_coincident_vertices",
-       bytes_file("m.obj", "v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n"), pre + "{dir}/m.obj",
-       "coincide"},
+      {"mesh_coincident_vertices", bytes_file("m.obj", "v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n"),
+       pre + "{dir}/m.obj", "coincide"},
       {"mesh_dragon_5", nullptr, pre + "dragon:5", "dragon:5"},
   };
 }
@@ -287,7 +289,9 @@ std::vector<BadCase> all_media_cases() {
 
 class BadMedia : public ::testing::TestWithParam<BadCase> {};
 
-TEST_P(BadMedia, AreRefusedCleanly) { expect_clean_refusal(GetParam()); }
+TEST_P(BadMedia, AreRefusedCleanly) {
+  expect_clean_refusal(GetParam());
+}
 
 INSTANTIATE_TEST_SUITE_P(Table, BadMedia, ::testing::ValuesIn(all_media_cases()),
                          [](const auto& info) { return info.param.name; });

@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.h"
-#include "lucent/acquire/image_io.h"
+#include "lucent/imaging/image_io.h"
 
 namespace lucent::testing {
 namespace {
@@ -208,7 +208,7 @@ TEST(RenderCommand, DefaultRigAndAutoExposure) {
   EXPECT_NE(r.err.find("--light directional:"), std::string::npos) << r.err;
   r = run_lucent(kTiny + "--material marble --exposure 1 -o \"" + dim.string() + "\"", "dim");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const auto bright = acquire::read_raw_image(png), dark = acquire::read_raw_image(dim);
+  const auto bright = imaging::read_raw_image(png), dark = imaging::read_raw_image(dim);
   ASSERT_EQ(bright.max_value, 255);
   double sum_bright = 0, sum_dark = 0;
   int max_bright = 0;
@@ -233,13 +233,16 @@ TEST(RenderCommand, SnapshotsAndCompare) {
   auto r = run_lucent(
       "render --material marble --mesh sphere --size 24x24 --frames 8 --directions 4 --samples 8 "
       "--disc-points 64 --radiance-map 32 --light-map 32 --light directional:1,0,1:1,1,1 "
-      "--snapshots 1,4,8 -o \"" + out.string() + "\"",
+      "--snapshots 1,4,8 -o \"" +
+          out.string() + "\"",
       "snapshots");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  for (int t : {1, 4, 8}) ASSERT_TRUE(fs::exists(dir / ("maps.f" + std::to_string(t) + ".exr"))) << t;
+  for (int t : {1, 4, 8})
+    ASSERT_TRUE(fs::exists(dir / ("maps.f" + std::to_string(t) + ".exr"))) << t;
   const auto difference = [&](const std::string& name) {
-    const auto c = run_lucent("compare \"" + (dir / name).string() + "\" \"" + out.string() + "\" --json",
-                              "compare-" + name);
+    const auto c =
+        run_lucent("compare \"" + (dir / name).string() + "\" \"" + out.string() + "\" --json",
+                   "compare-" + name);
     EXPECT_EQ(c.exit_code, 0) << c.err;
     return nlohmann::json::parse(c.out).at("relative_rmse").get<double>();
   };
@@ -247,8 +250,9 @@ TEST(RenderCommand, SnapshotsAndCompare) {
   EXPECT_GT(first, 0);
   EXPECT_EQ(last, 0);  // frame 8 of 8 is the final image
   EXPECT_LE(difference("maps.f4.exr"), first);
-  const auto bad = run_lucent("compare \"" + out.string() + "\" \"" + (dir / "none.exr").string() + "\"",
-                              "compare-missing");
+  const auto bad =
+      run_lucent("compare \"" + out.string() + "\" \"" + (dir / "none.exr").string() + "\"",
+                 "compare-missing");
   EXPECT_NE(bad.exit_code, 0);
   EXPECT_EQ(lines(bad.err), 1) << bad.err;
   fs::remove_all(dir);
@@ -265,8 +269,10 @@ namespace {
 TEST(RenderCommand, JsonSummaryOnStdout) {
   const auto dir = scratch_dir("render-json");
   const fs::path out = dir / "s.png";
-  const auto r = run_lucent(kTiny + "--material marble --mesh sphere --light directional:1,1,1:2,2,2 "
-                                    "--json -o \"" + out.string() + "\"",
+  const auto r = run_lucent(kTiny +
+                                "--material marble --mesh sphere --light directional:1,1,1:2,2,2 "
+                                "--json -o \"" +
+                                out.string() + "\"",
                             "json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto doc = nlohmann::json::parse(r.out);

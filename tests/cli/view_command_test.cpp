@@ -3,23 +3,25 @@
 // file edited while it runs) and screenshots show what it drew. Bad input fails with one line.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <unistd.h>
 #include <filesystem>
 #include <string>
 
 #include "cli_runner.h"
-#include "lucent/acquire/image_io.h"
+#include "lucent/imaging/image_io.h"
 
 namespace lucent::testing {
 namespace {
 
 namespace fs = std::filesystem;
 
-bool have_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
+bool have_xvfb() {
+  return std::system("command -v xvfb-run >/dev/null 2>&1") == 0;
+}
 
 // Tiny settings: llvmpipe renders a 64-texel, 8-direction frame in ~0.1 s.
 const std::string kTiny =
@@ -27,7 +29,7 @@ const std::string kTiny =
     " --radiance-map 64 --light-map 64 --samples-pixel 32 --threads 2";
 
 struct Shot {
-  acquire::RawImage image;
+  imaging::RawImage image;
   double mean[3] = {0, 0, 0};  // radiance x exposure over the pixels brighter than the background
   long lit = 0;
 };
@@ -41,7 +43,7 @@ double radiance_of(int code) {
 
 Shot load_shot(const fs::path& path) {
   Shot shot;
-  shot.image = acquire::read_raw_image(path);
+  shot.image = imaging::read_raw_image(path);
   for (int y = 0; y < shot.image.height; ++y) {
     for (int x = 0; x < shot.image.width; ++x) {
       const int sum = shot.image.at(x, y, 0) + shot.image.at(x, y, 1) + shot.image.at(x, y, 2);
@@ -64,7 +66,9 @@ long differing_pixels(const Shot& a, const Shot& b) {
 
 // xvfb-run -a probes for a free display from -n on; tests that ctest runs side by side start from
 // different numbers so that two of them do not claim the same one at the same moment.
-std::string server_number() { return std::to_string(100 + ::getpid() % 800); }
+std::string server_number() {
+  return std::to_string(100 + ::getpid() % 800);
+}
 
 class ViewCommand : public ::testing::Test {
  protected:
@@ -93,11 +97,11 @@ class ViewCommand : public ::testing::Test {
 };
 
 TEST_F(ViewCommand, ScriptOrbitsMovesTheLightAndSavesScreenshots) {
-  const CommandResult r = view(
-      "--material marble --light directional:1,0.3,0.5:1,1,1" + kTiny +
-      " --script 'settle; key h; screenshot a.png; orbit 150 0; wait 2; screenshot b.png;"
-      " light 150 0; settle; screenshot c.png; key h; wait 2; screenshot d.png;"
-      " screenshot-panel e.png; key s; quit'");
+  const CommandResult r =
+      view("--material marble --light directional:1,0.3,0.5:1,1,1" + kTiny +
+           " --script 'settle; key h; screenshot a.png; orbit 150 0; wait 2; screenshot b.png;"
+           " light 150 0; settle; screenshot c.png; key h; wait 2; screenshot d.png;"
+           " screenshot-panel e.png; key s; quit'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   for (const char* name : {"a.png", "b.png", "c.png", "d.png", "e.png", "lucent_view_001.png"}) {
     ASSERT_TRUE(fs::exists(dir_ / name)) << name << "\n" << r.out << r.err;
@@ -128,15 +132,17 @@ TEST_F(ViewCommand, ReloadsAnEditedMaterialDeformsAndShowsTheReference) {
   fs::copy_file(fs::path(LUCENT_SOURCE_DIR) / "materials/library/marble.json",
                 dir_ / "sample.json");
   // Edit the file while the window is open: once a.png exists, ketchup replaces marble.
-  const std::string edit = "(for i in $(seq 600); do [ -f a.png ] && break; sleep 0.1; done; cp \"" +
-                           (fs::path(LUCENT_SOURCE_DIR) / "materials/library/ketchup.json").string() +
-                           "\" sample.json) & ";
-  const CommandResult r = view(
-      "--material sample.json --light directional:0,0.3,1:1,1,1" + kTiny +
-      " --script 'settle; key h; screenshot a.png; sleep 3; settle; screenshot b.png;"
-      " set deform 0.1; wait 3; screenshot c.png; set deform 0; set technique reference; settle;"
-      " screenshot d.png; quit'",
-      edit);
+  const std::string edit =
+      "(for i in $(seq 600); do [ -f a.png ] && break; sleep 0.1; done; cp \"" +
+      (fs::path(LUCENT_SOURCE_DIR) / "materials/library/ketchup.json").string() +
+      "\" sample.json) & ";
+  const CommandResult r =
+      view("--material sample.json --light directional:0,0.3,1:1,1,1" + kTiny +
+               " --script 'settle; key h; screenshot a.png; sleep 3; settle; screenshot b.png;"
+               " set deform 0.1; wait 3; screenshot c.png; set deform 0; set technique reference; "
+               "settle;"
+               " screenshot d.png; quit'",
+           edit);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("sample.json changed, reloading"), std::string::npos) << r.out;
   for (const char* name : {"a.png", "b.png", "c.png", "d.png"}) {
@@ -149,7 +155,7 @@ TEST_F(ViewCommand, ReloadsAnEditedMaterialDeformsAndShowsTheReference) {
   const double warm = a.mean[0] / a.mean[2], red = b.mean[0] / b.mean[2];
   std::printf("red/blue: marble %.2f, ketchup %.2f (maps), %.2f (reference)\n", warm, red,
               d.mean[0] / d.mean[2]);
-  EXPECT_LT(warm, 2.2);  // measured 1.85
+  EXPECT_LT(warm, 2.2);        // measured 1.85
   EXPECT_GT(red, 1.3 * warm);  // measured 2.92 = 1.6 x marble
   // The deformed sphere is another shape.
   EXPECT_GT(differing_pixels(b, c), 300);
@@ -177,9 +183,10 @@ TEST_F(ViewCommand, BadInputFailsWithOneLine) {
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("--deform"), std::string::npos) << r.err;
   // No X display at all: it says what to do.
-  const std::string no_display = "env -u DISPLAY \"" LUCENT_BINARY
-                                 "\" view --material marble --light directional:0,0,1:1,1,1";
-  const int status = std::system((no_display + " >/dev/null 2>\"" + (dir_ / "e").string() + "\"").c_str());
+  const std::string no_display =
+      "env -u DISPLAY \"" LUCENT_BINARY "\" view --material marble --light directional:0,0,1:1,1,1";
+  const int status =
+      std::system((no_display + " >/dev/null 2>\"" + (dir_ / "e").string() + "\"").c_str());
   EXPECT_NE(status, 0);
   EXPECT_NE(read_text(dir_ / "e").find("xvfb-run"), std::string::npos) << read_text(dir_ / "e");
   for (const auto& entry : fs::directory_iterator(dir_)) {

@@ -9,7 +9,7 @@
 #include <numbers>
 #include <string>
 
-#include "lucent/acquire/image_io.h"
+#include "lucent/imaging/image_io.h"
 #include "lucent/materials/error.h"
 #include "lucent/render/environment.h"
 
@@ -28,7 +28,7 @@ fs::path scratch(const std::string& name) {
 
 EnvironmentMap constant_map(int w, int h, float value) {
   EnvironmentMap map;
-  map.image = acquire::ImageRgb(w, h, value);
+  map.image = imaging::ImageRgb(w, h, value);
   map.source = "constant";
   return map;
 }
@@ -131,9 +131,9 @@ TEST(EnvironmentLights, BlackMapGivesNoLightsAndBadCountThrows) {
 
 TEST(LoadEnvironment, ReadsExr) {
   const fs::path path = scratch("sky.exr");
-  acquire::ImageRgb image(8, 4, 0.5f);
+  imaging::ImageRgb image(8, 4, 0.5f);
   image.at(3, 1, 2) = 9.0f;
-  acquire::write_exr(path, image);
+  imaging::write_exr(path, image);
   const EnvironmentMap map = load_environment(path);
   EXPECT_EQ(map.image.width, 8);
   EXPECT_EQ(map.image.height, 4);

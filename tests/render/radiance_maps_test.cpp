@@ -8,18 +8,18 @@
 
 #include <Eigen/Geometry>
 
+#include <unistd.h>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <unistd.h>
 #include <filesystem>
 #include <memory>
 #include <numbers>
 #include <string>
 #include <vector>
 
-#include "lucent/acquire/image_io.h"
+#include "lucent/imaging/image_io.h"
 #include "lucent/materials/error.h"
 #include "lucent/materials/fresnel.h"
 #include "lucent/materials/material.h"
@@ -443,8 +443,8 @@ TEST_F(RadianceMapsTest, TurningMeshLightAndCameraTogetherKeepsTheImage) {
   };
   const auto [image, mask] = render(scene);
 
-  const Eigen::Matrix3f turn = Eigen::AngleAxisf(std::numbers::pi_v<float> / 2, Vec3f::UnitY())
-                                   .toRotationMatrix();
+  const Eigen::Matrix3f turn =
+      Eigen::AngleAxisf(std::numbers::pi_v<float> / 2, Vec3f::UnitY()).toRotationMatrix();
   Scene turned = scene;
   for (Vec3f& p : turned.mesh.positions) p = turn * p;
   for (Vec3f& n : turned.mesh.normals) n = turn * n;
@@ -477,12 +477,12 @@ TEST_F(RadianceMapsTest, TurningMeshLightAndCameraTogetherKeepsTheImage) {
 // F_r(eta, n . w_o) everywhere on the object (exact Fresnel of the material's ior: about 0.04 where
 // the surface faces the camera, growing toward the silhouette), and the background shows the map.
 TEST_F(RadianceMapsTest, EnvironmentReflectionAddsTheFresnelWeightedMap) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("lucent-env-" + std::to_string(::getpid()));
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("lucent-env-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   ImageRgb white(32, 16);
   std::fill(white.data.begin(), white.data.end(), 1.0f);
-  acquire::write_exr(dir / "white.exr", white);
+  imaging::write_exr(dir / "white.exr", white);
   Scene scene = sphere_scene(41);
   scene.environment = dir / "white.exr";
   const RenderSettings settings = tiny_settings(2);
@@ -522,7 +522,8 @@ TEST_F(RadianceMapsTest, EnvironmentReflectionAddsTheFresnelWeightedMap) {
 // an extension) the gather is an unbiased estimate of the disc integral, and accumulating frames
 // does converge toward the reference: marble under one directional light, N = M = 16, measured 1.05
 // after one frame and 0.30 after 32 (mean ratio 0.77; the rest is the 32-texel maps' resolution and
-// the heavy-tailed e^(sigma* r) weights of the exponential disc). Bound: 32 frames at most 0.7 of the first frame's error.
+// the heavy-tailed e^(sigma* r) weights of the exponential disc). Bound: 32 frames at most 0.7 of
+// the first frame's error.
 TEST_F(RadianceMapsTest, NewRadiiEachFrameConvergeTowardTheReference) {
   Scene scene = sphere_scene(32, "marble");
   scene.lights = {parse_light("directional:1,0.5,0.5:1,1,1")};

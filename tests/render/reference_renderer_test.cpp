@@ -14,7 +14,7 @@
 
 #include <Eigen/Geometry>
 
-#include "lucent/acquire/image_io.h"
+#include "lucent/imaging/image_io.h"
 #include "lucent/materials/error.h"
 #include "lucent/materials/material.h"
 #include "lucent/render/reference_renderer.h"
@@ -273,7 +273,7 @@ TEST(ReferenceRenderer, ResultDoesNotDependOnThreads) {
 TEST(ReferenceRenderer, EnvironmentIsTheBackground) {
   const fs::path path =
       fs::temp_directory_path() / ("lucent-reference-env-" + std::to_string(::getpid()) + ".exr");
-  acquire::write_exr(path, acquire::ImageRgb(16, 8, 0.7f));
+  imaging::write_exr(path, imaging::ImageRgb(16, 8, 0.7f));
   Scene scene = sphere_scene(16);
   scene.environment = path;
   const ReferenceImage r = render_reference(scene, DiffusionModel::kDipole, small_options(500));

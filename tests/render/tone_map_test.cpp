@@ -7,7 +7,7 @@
 #include <limits>
 #include <string>
 
-#include "lucent/acquire/image_io.h"
+#include "lucent/imaging/image_io.h"
 #include "lucent/materials/error.h"
 #include "lucent/render/tone_map.h"
 
@@ -48,12 +48,12 @@ TEST(SrgbEncode, MatchesTheStandard) {
 }
 
 TEST(ToneMap, ExposureThenCurveThenSrgb) {
-  acquire::ImageRgb linear(2, 1, 0.0f);
+  imaging::ImageRgb linear(2, 1, 0.0f);
   linear.at(0, 0, 0) = 0.5f;
   linear.at(1, 0, 1) = 1e6f;
   ToneMapOptions options;
   options.exposure = 2;  // 0.5 -> 1 -> 0.5 -> sRGB 0.7354 -> 188
-  const acquire::RawImage out = tone_map(linear, options);
+  const imaging::RawImage out = tone_map(linear, options);
   EXPECT_EQ(out.max_value, 255);
   EXPECT_EQ(out.at(0, 0, 0), 188);
   EXPECT_EQ(out.at(0, 0, 1), 0);
@@ -61,24 +61,24 @@ TEST(ToneMap, ExposureThenCurveThenSrgb) {
 }
 
 TEST(WriteRenderImage, PngAndLinearExr) {
-  acquire::ImageRgb linear(4, 3, 0.25f);
+  imaging::ImageRgb linear(4, 3, 0.25f);
   linear.at(2, 1, 0) = 3.0f;
   const fs::path exr = scratch("out.exr"), png = scratch("out.PNG");
   ToneMapOptions options;
   options.exposure = 4;  // must not touch the EXR
   write_render_image(exr, linear, options);
   write_render_image(png, linear, options);
-  const acquire::ImageRgb back = acquire::read_exr(exr);
+  const imaging::ImageRgb back = imaging::read_exr(exr);
   EXPECT_FLOAT_EQ(back.at(2, 1, 0), 3.0f);
   EXPECT_FLOAT_EQ(back.at(0, 0, 0), 0.25f);
-  const acquire::RawImage raw = acquire::read_raw_image(png);
+  const imaging::RawImage raw = imaging::read_raw_image(png);
   EXPECT_EQ(raw.width, 4);
   EXPECT_EQ(raw.at(0, 0, 0), 188);  // 0.25 * 4 = 1 -> 0.5 -> 188
 }
 
 TEST(WriteRenderImage, OtherExtensionsThrowAndWriteNothing) {
   const fs::path tif = scratch("out.tif");
-  EXPECT_THROW(write_render_image(tif, acquire::ImageRgb(2, 2, 1.0f)), Error);
+  EXPECT_THROW(write_render_image(tif, imaging::ImageRgb(2, 2, 1.0f)), Error);
   EXPECT_FALSE(fs::exists(tif));
   EXPECT_TRUE(is_render_image_path("a/b.exr"));
   EXPECT_TRUE(is_render_image_path("b.Png"));

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "lucent/acquire/capture.h"
-#include "lucent/acquire/image.h"
+#include "lucent/imaging/image.h"
 
 namespace lucent::acquire {
 
@@ -41,8 +41,8 @@ double camera_scale(const CameraOptions& options, double peak_radiance);
 /// One bracket: expected electrons = radiance * exposure_s * scale + black level; shot noise on the
 /// signal, read noise on everything; clipped at 0 and the full well; encoded (linear or sRGB) and
 /// quantised to the bit depth. `stream` distinguishes images drawn with the same seed.
-RawImage expose(const ImageRgb& radiance, double exposure_s, double scale,
-                const CameraOptions& options, std::uint64_t stream);
+imaging::RawImage expose(const imaging::ImageRgb& radiance, double exposure_s, double scale,
+                         const CameraOptions& options, std::uint64_t stream);
 
 /// The sRGB transfer function and its inverse on [0, 1].
 double srgb_encode(double linear);

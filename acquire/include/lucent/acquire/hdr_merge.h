@@ -40,8 +40,8 @@
 #include <vector>
 
 #include "lucent/acquire/capture.h"
-#include "lucent/acquire/image.h"
 #include "lucent/acquire/profile.h"
+#include "lucent/imaging/image.h"
 
 namespace lucent::acquire {
 
@@ -78,9 +78,9 @@ struct NoiseModel {
 };
 
 struct HdrResult {
-  ImageRgb radiance;            ///< linear, per second of exposure; 0 where masked
-  ImageRgb standard_error;      ///< of radiance, same units; 0 where masked
-  std::vector<PixelMask> mask;  ///< per pixel and channel, indexed like ImageRgb::data
+  imaging::ImageRgb radiance;        ///< linear, per second of exposure; 0 where masked
+  imaging::ImageRgb standard_error;  ///< of radiance, same units; 0 where masked
+  std::vector<PixelMask> mask;  ///< per pixel and channel, indexed like imaging::ImageRgb::data
   MaskCounts counts;
   NoiseModel noise;
   std::optional<ResponseCurve> response;       ///< the curve used (absent for an 'hdr' input)

@@ -54,13 +54,13 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
 /// The exit radiance per unit power (mm^-2 sr^-1) that a diffusion model predicts on the
 /// simulation's pixel grid, each pixel averaged over 4 x 4 points (the entry point's pixel over 16
 /// x 16).
-ImageRgb model_radiance(const materials::Material& material, RadianceSource source,
-                        const PhotonTransportOptions& geometry);
+imaging::ImageRgb model_radiance(const materials::Material& material, RadianceSource source,
+                                 const PhotonTransportOptions& geometry);
 
 /// The radiance image of a Lambertian reference of reflectance rho lit by the same beam (unit
 /// power): rho / pi times a Gaussian spot of width sigma_mm integrated over each pixel (per mm^2),
 /// so that the image integrated over the plane is rho / pi exactly, up to the spot's tail beyond
 /// the grid.
-ImageRgb white_reference_radiance(int size, double pixel_mm, double rho, double sigma_mm);
+imaging::ImageRgb white_reference_radiance(int size, double pixel_mm, double rho, double sigma_mm);
 
 }  // namespace lucent::acquire

@@ -17,7 +17,7 @@
 
 #include <Eigen/Core>
 
-#include "lucent/acquire/image.h"
+#include "lucent/imaging/image.h"
 #include "lucent/render/scene.h"
 
 namespace lucent::render {
@@ -27,7 +27,7 @@ using Vec2f = Eigen::Vector2f;
 /// Linear RGB radiance per direction, lat-long; relative units (the same as Light::radiance per
 /// sr).
 struct EnvironmentMap {
-  acquire::ImageRgb image;
+  imaging::ImageRgb image;
   std::filesystem::path source;
 
   std::string to_string() const;

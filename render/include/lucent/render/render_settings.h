@@ -12,12 +12,12 @@
 
 #include <nlohmann/json.hpp>
 
-#include "lucent/acquire/image.h"
+#include "lucent/imaging/image.h"
 #include "lucent/materials/profile_table.h"
 
 namespace lucent::render {
 
-using ImageRgb = acquire::ImageRgb;
+using ImageRgb = imaging::ImageRgb;
 using materials::DiffusionModel;
 
 /// Which N of the M disc points a texel gathers in a frame (--disc-selection).
@@ -43,7 +43,8 @@ enum class DiscDistribution {
   /// starves (seed 003's e^(-sigma* r) with sigma* = sigma_tr / q puts ~1 of 1000 points
   /// inside marble's mean free path).
   kProfile,
-  /// Seed 003 §5.3.4.1: Halton points kept with probability e^(-sigma* r), sigma* = min sigma_tr / q.
+  /// Seed 003 §5.3.4.1: Halton points kept with probability e^(-sigma* r), sigma* = min sigma_tr /
+  /// q.
   kExponential,
 };
 
@@ -56,7 +57,7 @@ struct RenderSettings {
   int samples = 50;     ///< N: disc samples gathered per texel per frame (--samples)
   int disc_points = 1000;  ///< M: exponentially biased Halton disc points (--disc-points), N <= M
   double q = 1.0;          ///< sigma* = min_c sigma_tr,c / q, the disc's bias (--q), > 0
-  DiscSelection disc_selection = DiscSelection::kStrata;  ///< --disc-selection
+  DiscSelection disc_selection = DiscSelection::kStrata;            ///< --disc-selection
   DiscDistribution disc_distribution = DiscDistribution::kProfile;  ///< --disc-distribution
   int radiance_map_size = 512;  ///< W_s: radiance-map layer size in texels (--radiance-map)
   int light_map_size = 512;     ///< W_l: light-map size in texels (--light-map)

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "lucent/acquire/image.h"
+#include "lucent/imaging/image.h"
 
 namespace lucent::render {
 
@@ -27,12 +27,12 @@ float tone_curve(float x);
 float srgb_encode(float linear);
 
 /// exposure -> tone_curve -> srgb_encode -> 8-bit RGB (rounded).
-acquire::RawImage tone_map(const acquire::ImageRgb& linear, const ToneMapOptions& options = {});
+imaging::RawImage tone_map(const imaging::ImageRgb& linear, const ToneMapOptions& options = {});
 
 /// Writes an image by the name's extension, atomically: `.exr` linear float RGB as given (no
 /// exposure, no tone curve; `attributes` go into the header); `.png` tone-mapped 8-bit sRGB.
 /// Any other extension throws lucent::Error naming the file.
-void write_render_image(const std::filesystem::path& path, const acquire::ImageRgb& linear,
+void write_render_image(const std::filesystem::path& path, const imaging::ImageRgb& linear,
                         const ToneMapOptions& options = {},
                         const std::map<std::string, std::string>& attributes = {});
 
@@ -40,7 +40,7 @@ void write_render_image(const std::filesystem::path& path, const acquire::ImageR
 /// (0.2126 R + 0.7152 G + 0.0722 B over pixels where mask != 0, or every non-black pixel when the
 /// mask is empty) at 2, which the tone curve maps to 2/3: the bright side is bright and still
 /// shaded (Reinhard never clips). 1 for an all-black image.
-float auto_exposure(const acquire::ImageRgb& linear, const std::vector<std::uint8_t>& mask = {});
+float auto_exposure(const imaging::ImageRgb& linear, const std::vector<std::uint8_t>& mask = {});
 
 /// True for the extensions write_render_image accepts (.png, .exr; any case).
 bool is_render_image_path(const std::filesystem::path& path);

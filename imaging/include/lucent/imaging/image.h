@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <vector>
 
-namespace lucent::acquire {
+namespace lucent::imaging {
 
 /// Linear float RGB, row-major, rows along +y; pixel (x, y) channel c at data[(y * width + x) * 3 +
 /// c].
@@ -37,4 +37,4 @@ struct RawImage {
   std::uint16_t at(int x, int y, int c) const { return data[(std::size_t(y) * width + x) * 3 + c]; }
 };
 
-}  // namespace lucent::acquire
+}  // namespace lucent::imaging

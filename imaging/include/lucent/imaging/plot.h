@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-namespace lucent::acquire {
+namespace lucent::imaging {
 
 struct PlotSeries {
   std::vector<double> x, y;
@@ -35,4 +35,4 @@ void write_plot_png(const std::filesystem::path& path, const std::vector<PlotPan
                     const std::vector<std::string>& footer = {}, int width = 1000,
                     int height = 800);
 
-}  // namespace lucent::acquire
+}  // namespace lucent::imaging

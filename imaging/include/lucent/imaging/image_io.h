@@ -7,9 +7,9 @@
 #include <map>
 #include <string>
 
-#include "lucent/acquire/image.h"
+#include "lucent/imaging/image.h"
 
-namespace lucent::acquire {
+namespace lucent::imaging {
 
 /// Linear float RGB from an OpenEXR file (R, G, B channels; Y alone is read as grey).
 ImageRgb read_exr(const std::filesystem::path& path);
@@ -31,4 +31,4 @@ ImageRgb read_radiance_hdr(const std::filesystem::path& path);
 /// Either reader by extension: .exr -> read_exr; anything else -> read_raw_image scaled to [0, 1].
 ImageRgb read_any_image(const std::filesystem::path& path);
 
-}  // namespace lucent::acquire
+}  // namespace lucent::imaging

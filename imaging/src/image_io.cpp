@@ -1,4 +1,4 @@
-#include "lucent/acquire/image_io.h"
+#include "lucent/imaging/image_io.h"
 
 #include <Iex.h>
 #include <ImfChannelList.h>
@@ -22,7 +22,7 @@
 #include "lucent/materials/error.h"
 #include "lucent/materials/json_file.h"
 
-namespace lucent::acquire {
+namespace lucent::imaging {
 
 namespace {
 
@@ -70,8 +70,7 @@ cv::Mat decode_image_quietly(const std::filesystem::path& path, int flags) {
   (void)silenced;
   // Read by lucent (bounded, recorded as an input), decoded from memory by OpenCV.
   const std::string bytes = read_input_file(path, std::size_t(1) << 30);
-  const cv::Mat buffer(1, static_cast<int>(bytes.size()), CV_8U,
-                       const_cast<char*>(bytes.data()));
+  const cv::Mat buffer(1, static_cast<int>(bytes.size()), CV_8U, const_cast<char*>(bytes.data()));
   cv::Mat mat;
   try {
     QuietStderr quiet;
@@ -258,4 +257,4 @@ ImageRgb read_any_image(const std::filesystem::path& path) {
   return image;
 }
 
-}  // namespace lucent::acquire
+}  // namespace lucent::imaging

@@ -1,4 +1,4 @@
-#include "lucent/acquire/plot.h"
+#include "lucent/imaging/plot.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
 
-namespace lucent::acquire {
+namespace lucent::imaging {
 namespace {
 
 cv::Scalar bgr(const std::array<std::uint8_t, 3>& rgb) {
@@ -183,4 +183,4 @@ void write_plot_png(const std::filesystem::path& path, const std::vector<PlotPan
   out.commit();
 }
 
-}  // namespace lucent::acquire
+}  // namespace lucent::imaging
