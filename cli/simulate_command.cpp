@@ -6,11 +6,11 @@
 #include <sstream>
 
 #include "commands.h"
+#include "lucent/acquire/simulate.h"
+#include "lucent/materials/atomic_file.h"
+#include "lucent/materials/error.h"
 #include "progress.h"
 #include "validators.h"
-#include "lucent/materials/atomic_file.h"
-#include "lucent/acquire/simulate.h"
-#include "lucent/materials/error.h"
 
 namespace lucent::cli {
 namespace {
@@ -19,7 +19,8 @@ struct SimulateArguments {
   std::string material;
   std::string output;
   std::string exposures = "1/1000,1/250,1/60,1/15,1/4";
-  std::string response = "srgb";
+  std::string response;  // empty: srgb for PNG brackets, linear for DNG
+  std::string bracket_format = "png";
   std::string source = "montecarlo";
   std::string exitance_csv;
   bool no_white = false;
@@ -65,6 +66,13 @@ std::vector<double> parse_exposures(const std::string& text) {
 void run(SimulateArguments& args) {
   acquire::SimulateOptions& o = args.options;
   o.material = materials::load_material(args.material);
+  if (args.bracket_format == "png")
+    o.bracket_format = acquire::BracketFormat::kPng;
+  else if (args.bracket_format == "dng")
+    o.bracket_format = acquire::BracketFormat::kDng;
+  else
+    throw Error("--bracket-format: expected 'png' or 'dng', got '" + args.bracket_format + "'");
+  if (args.response.empty()) args.response = args.bracket_format == "dng" ? "linear" : "srgb";
   if (args.response == "srgb")
     o.camera.response = acquire::Response::kSrgb;
   else if (args.response == "linear")
@@ -181,10 +189,15 @@ void register_simulate_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--exposures", args->exposures, "exposure times in s, increasing")
       ->capture_default_str();
-  cmd->add_option("--response", args->response, "camera encoding: srgb or linear")
+  cmd->add_option("--response", args->response,
+                  "camera encoding: srgb or linear (default: srgb for PNG, linear for DNG)");
+  cmd->add_option("--bracket-format", args->bracket_format,
+                  "bracket files: png (the camera's encoding) or dng (a Bayer sensor's linear "
+                  "RAW codes with black level, exposure time and ISO in each file)")
       ->capture_default_str();
   cmd->add_option("--bits", o.camera.bits, "bits per channel: 8 or 16")
-      ->check(whole_in(8, 16, "bits per channel (8 or 16)"))->capture_default_str();
+      ->check(whole_in(8, 16, "bits per channel (8 or 16)"))
+      ->capture_default_str();
   cmd->add_option("--full-well-e", o.camera.full_well_e, "electrons at saturation")
       ->check(number_in(100, 1e9, "electrons"))
       ->capture_default_str();

@@ -259,6 +259,14 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
     const WhiteReference& reference = *capture.white_reference;
     const HdrResult white =
         merge_brackets(reference.images, capture.response, capture.dark, capture.base_dir, curve);
+    if (white.iso_scaled != hdr.iso_scaled) {
+      throw Error(capture_json.string() + ": field 'white_reference.images': the " +
+                  (white.iso_scaled ? "white reference's" : "sample's") +
+                  " brackets have an ISO and the " +
+                  (white.iso_scaled ? "sample's" : "white reference's") +
+                  " do not, so their radiances are on different scales (give 'iso' for both or "
+                  "for neither)");
+    }
     const BeamPower power = white_reference_power(white, reference.reflectance,
                                                   capture.pixel_pitch_mm, white.sources_text);
     summary.beam_power = power.power;
@@ -346,9 +354,11 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
       {"beam_power_source", summary.beam_power_source},
       {"white_reference", white_json}};
   if (!capture.sample.hdr) {
-    json exposures = json::array();
-    for (const Bracket& b : capture.sample.images) exposures.push_back(b.exposure_s);
-    provenance["exposures_s"] = exposures;
+    provenance["exposures_s"] = hdr.exposure_s;
+    if (hdr.iso_scaled) provenance["exposures_scaled_by"] = "ISO / 100";
+    if (hdr.camera_raw) {
+      provenance["camera_raw"] = "2x2 Bayer quads, black and white levels from the files";
+    }
   }
   if (detected) {
     provenance["beam_detection"] = {{"peak_luminance", detected->peak},

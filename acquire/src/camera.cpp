@@ -114,4 +114,41 @@ imaging::RawImage expose(const imaging::ImageRgb& radiance, double exposure_s, d
   return out;
 }
 
+imaging::BayerMosaic expose_mosaic(const imaging::ImageRgb& radiance, double exposure_s,
+                                   double scale, const CameraOptions& options,
+                                   std::uint64_t stream) {
+  if (options.bits != 16 || options.response != Response::kLinear) {
+    throw Error(
+        "--bracket-format dng: a RAW sensor records linear 16-bit codes (use --bits 16 "
+        "--response linear)");
+  }
+  CameraOptions sensor = options;
+  const int black_code = int(std::lround(options.black_level_e / options.full_well_e * 65535));
+  sensor.black_level_e = black_code * options.full_well_e / 65535;
+  // Every photosite of a quad sees its pixel: expose the image at twice the resolution.
+  const int w = radiance.width, h = radiance.height;
+  imaging::ImageRgb sites(2 * w, 2 * h);
+  for (int y = 0; y < 2 * h; ++y) {
+    for (int x = 0; x < 2 * w; ++x) {
+      for (int c = 0; c < 3; ++c) sites.at(x, y, c) = radiance.at(x / 2, y / 2, c);
+    }
+  }
+  const imaging::RawImage codes = expose(sites, exposure_s, scale, sensor, stream);
+  imaging::BayerMosaic mosaic;
+  mosaic.width = 2 * w;
+  mosaic.height = 2 * h;
+  mosaic.data.resize(std::size_t(mosaic.width) * mosaic.height);
+  for (int y = 0; y < mosaic.height; ++y) {
+    for (int x = 0; x < mosaic.width; ++x) {
+      const int colour = mosaic.pattern[(y % 2) * 2 + x % 2];
+      mosaic.data[std::size_t(y) * mosaic.width + x] = codes.at(x, y, colour);
+    }
+  }
+  mosaic.black_level = black_code;
+  mosaic.white_level = 65535;
+  mosaic.exposure_s = exposure_s;
+  mosaic.iso = 100;
+  return mosaic;
+}
+
 }  // namespace lucent::acquire

@@ -5,6 +5,7 @@
 #include <set>
 #include <sstream>
 
+#include "lucent/imaging/camera_raw.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
 #include "lucent/materials/json_file.h"
@@ -83,14 +84,26 @@ ImageSet read_image_set(const json& doc, const std::string& prefix, const FieldR
   for (std::size_t i = 0; i < images.size(); ++i) {
     const std::string field = prefix + "images[" + std::to_string(i) + "]";
     const json& image = in.object(images[i], field);
-    in.only_known(image, field + ".", {"path", "exposure_s"});
+    in.only_known(image, field + ".", {"path", "exposure_s", "iso"});
     if (!image.contains("path")) in.fail(field + ".path", "missing");
-    if (!image.contains("exposure_s")) in.fail(field + ".exposure_s", "missing");
-    Bracket b{in.string(image["path"], field + ".path"),
-              in.number(image["exposure_s"], field + ".exposure_s")};
-    if (!(b.exposure_s >= 1e-9 && b.exposure_s <= 1e6))
-      in.fail(field + ".exposure_s", "expected an exposure time in [1e-9, 1e6] s");
-    if (!set.images.empty() && !(b.exposure_s > set.images.back().exposure_s)) {
+    Bracket b{in.string(image["path"], field + ".path")};
+    // A camera RAW file knows its exposure time and ISO: the capture may leave them out.
+    const bool raw = imaging::is_camera_raw_path(b.path);
+    if (image.contains("exposure_s")) {
+      b.exposure_s = in.number(image["exposure_s"], field + ".exposure_s");
+      if (!(b.exposure_s >= 1e-9 && b.exposure_s <= 1e6))
+        in.fail(field + ".exposure_s", "expected an exposure time in [1e-9, 1e6] s");
+    } else if (!raw) {
+      in.fail(field + ".exposure_s",
+              "missing (only camera RAW files carry their exposure time in the file)");
+    }
+    if (image.contains("iso")) {
+      b.iso = in.number(image["iso"], field + ".iso");
+      if (!(*b.iso >= 1 && *b.iso <= 1e7)) in.fail(field + ".iso", "expected an ISO in [1, 1e7]");
+    }
+    // Known exposures must increase; those read from RAW files are ordered when they are read.
+    if (b.exposure_s > 0 && !set.images.empty() && set.images.back().exposure_s > 0 &&
+        !(b.exposure_s > set.images.back().exposure_s)) {
       in.fail(field + ".exposure_s",
               "exposures must increase strictly from one image to the next (got " +
                   std::to_string(b.exposure_s) + " s after " +
@@ -108,7 +121,10 @@ json image_set_to_json(const ImageSet& set) {
   } else {
     doc["images"] = json::array();
     for (const Bracket& b : set.images) {
-      doc["images"].push_back({{"path", b.path.generic_string()}, {"exposure_s", b.exposure_s}});
+      json image = {{"path", b.path.generic_string()}};
+      if (b.exposure_s > 0) image["exposure_s"] = b.exposure_s;
+      if (b.iso) image["iso"] = *b.iso;
+      doc["images"].push_back(image);
     }
   }
   return doc;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/photo.hpp>
@@ -119,31 +120,84 @@ std::array<double, 2> fit_variance_model(std::vector<Row>& rows, const std::vect
 
 struct Stack {
   std::vector<imaging::RawImage> images;
-  std::vector<double> exposure_s;
+  std::vector<double> exposure_s;  ///< effective: the time, times ISO / 100 where the ISO is known
   std::vector<fs::path> paths;
+  bool iso_known = false;
 };
 
+bool is_camera_raw(const imaging::RawImage& image) {
+  return image.black != std::array<double, 3>{0.0, 0.0, 0.0} ||
+         (image.max_value != 255 && image.max_value != 65535) || image.metadata.exposure_s ||
+         image.metadata.iso;
+}
+
+std::string code_range(const imaging::RawImage& image) {
+  if (image.max_value == 255 && !is_camera_raw(image)) return "8-bit";
+  if (image.max_value == 65535 && !is_camera_raw(image)) return "16-bit";
+  char text[96];
+  std::snprintf(text, sizeof text, "RAW with black %.6g/%.6g/%.6g and white %d", image.black[0],
+                image.black[1], image.black[2], image.max_value);
+  return text;
+}
+
+// Reads the brackets, takes exposure times and ISO from RAW metadata where the capture leaves them
+// out, and orders them by effective exposure (the time scaled by ISO / 100 when every image's ISO
+// is known: a RAW code grows with the sensor gain the ISO sets).
 Stack read_stack(const ImageSet& set, const fs::path& base_dir) {
-  Stack stack;
+  struct Read {
+    imaging::RawImage image;
+    double exposure_s;
+    std::optional<double> iso;
+    fs::path path;
+  };
+  std::vector<Read> read;
   for (const Bracket& b : set.images) {
     const fs::path path = resolve(base_dir, b.path);
     imaging::RawImage image = imaging::read_raw_image(path);
-    if (!stack.images.empty()) {
-      const imaging::RawImage& first = stack.images.front();
+    const double t = b.exposure_s > 0 ? b.exposure_s : image.metadata.exposure_s.value_or(0.0);
+    if (!(t > 0)) {
+      throw Error(path.string() +
+                  ": no exposure time in the file's metadata; give 'exposure_s' in the capture");
+    }
+    const std::optional<double> iso = b.iso ? b.iso : image.metadata.iso;
+    if (!read.empty()) {
+      const imaging::RawImage& first = read.front().image;
+      const fs::path& first_path = read.front().path;
       if (image.width != first.width || image.height != first.height) {
         throw Error(path.string() + ": image is " + size_text(image.width, image.height) +
-                    " pixels but " + stack.paths.front().string() + " is " +
+                    " pixels but " + first_path.string() + " is " +
                     size_text(first.width, first.height) + " (all brackets must have one size)");
       }
-      if (image.max_value != first.max_value) {
-        throw Error(path.string() + ": " + (image.max_value == 255 ? "8" : "16") + "-bit but " +
-                    stack.paths.front().string() + " is " + (first.max_value == 255 ? "8" : "16") +
-                    "-bit (all brackets must have one bit depth)");
+      if (image.max_value != first.max_value || image.black != first.black) {
+        throw Error(path.string() + ": " + code_range(image) + " but " + first_path.string() +
+                    " is " + code_range(first) +
+                    " (all brackets must have one bit depth and one black and white level)");
+      }
+      if (iso.has_value() != read.front().iso.has_value()) {
+        const fs::path& without = iso ? first_path : path;
+        throw Error(without.string() +
+                    ": no ISO, while another bracket of the set has one (give "
+                    "'iso' for every image of the set, or for none)");
       }
     }
-    stack.images.push_back(std::move(image));
-    stack.exposure_s.push_back(b.exposure_s);
-    stack.paths.push_back(path);
+    read.push_back({std::move(image), t, iso, path});
+  }
+  if (read.empty()) throw Error("no images to merge");
+  for (Read& r : read) {
+    if (r.iso) r.exposure_s *= *r.iso / 100.0;
+  }
+  std::stable_sort(read.begin(), read.end(),
+                   [](const Read& a, const Read& b) { return a.exposure_s < b.exposure_s; });
+  Stack stack;
+  stack.iso_known = read.front().iso.has_value();
+  for (std::size_t k = 0; k < read.size(); ++k) {
+    if (k > 0 && !(read[k].exposure_s > read[k - 1].exposure_s)) {
+      throw Error(read[k].path.string() + ": same exposure as " + read[k - 1].path.string() +
+                  " (exposures must differ from one bracket to the next)");
+    }
+    stack.images.push_back(std::move(read[k].image));
+    stack.exposure_s.push_back(read[k].exposure_s);
+    stack.paths.push_back(read[k].path);
   }
   if (stack.images.empty()) throw Error("no images to merge");
   return stack;
@@ -469,22 +523,28 @@ HdrResult merge_stack(const Stack& stack, const ResponseCurve& curve,
 
 }  // namespace
 
-ResponseCurve standard_response(Response kind, int max_value) {
+ResponseCurve standard_response(Response kind, int max_value, const std::array<double, 3>& black) {
   if (kind == Response::kCalibrate) {
     throw Error("response 'calibrate': the curve is recovered from the brackets, not standard");
   }
-  if (max_value != 255 && max_value != 65535) {
-    throw Error("response: max value " + std::to_string(max_value) + " (expected 255 or 65535)");
+  if (!(max_value >= 2 && max_value <= 65535)) {
+    throw Error("response: max value " + std::to_string(max_value) + " (expected 2..65535)");
   }
   ResponseCurve curve;
   curve.kind = kind;
   curve.max_value = max_value;
-  std::vector<double> table(std::size_t(max_value) + 1);
-  for (int v = 0; v <= max_value; ++v) {
-    const double encoded = double(v) / max_value;
-    table[v] = kind == Response::kSrgb ? srgb_decode(encoded) : encoded;
+  for (int c = 0; c < 3; ++c) {
+    if (!(black[c] >= 0 && black[c] < max_value - 1)) {
+      throw Error("response: black level " + std::to_string(black[c]) +
+                  " is not below the white level " + std::to_string(max_value));
+    }
+    std::vector<double>& table = curve.linear[c];
+    table.resize(std::size_t(max_value) + 1);
+    for (int v = 0; v <= max_value; ++v) {
+      const double encoded = (v - black[c]) / (max_value - black[c]);
+      table[v] = kind == Response::kSrgb ? srgb_decode(encoded) : encoded;
+    }
   }
-  curve.linear = {table, table, table};
   return curve;
 }
 
@@ -494,10 +554,10 @@ ResponseCurve calibrate_response(const ImageSet& brackets, const fs::path& base_
                 ": response 'calibrate' needs exposure brackets, not an HDR image");
   }
   const Stack stack = read_stack(brackets, base_dir);
-  if (stack.images.front().max_value != 255) {
+  if (stack.images.front().max_value != 255 || is_camera_raw(stack.images.front())) {
     throw Error(stack.paths.front().string() +
-                ": response 'calibrate' needs 8-bit brackets (OpenCV's CalibrateDebevec), found "
-                "16-bit; use response 'linear' or 'srgb'");
+                ": response 'calibrate' needs 8-bit brackets (OpenCV's CalibrateDebevec), found " +
+                code_range(stack.images.front()) + "; use response 'linear' (or 'srgb')");
   }
   if (stack.images.size() < 2) {
     throw Error(stack.paths.front().string() +
@@ -545,36 +605,46 @@ HdrResult merge_brackets(const ImageSet& set, Response response,
                          const std::optional<ResponseCurve>& curve) {
   if (set.hdr) return read_hdr(set, dark, base_dir);
   const Stack stack = read_stack(set, base_dir);
-  const int max_value = stack.images.front().max_value;
+  const imaging::RawImage& first = stack.images.front();
+  const int max_value = first.max_value;
+  if (is_camera_raw(first) &&
+      (response != Response::kLinear || (curve && curve->kind != Response::kLinear))) {
+    throw Error(stack.paths.front().string() +
+                ": field 'response': camera RAW codes are linear; "
+                "use \"linear\" (found \"" +
+                to_string(curve ? curve->kind : response) + "\")");
+  }
   ResponseCurve used;
   if (curve) {
     used = *curve;
     if (used.max_value != max_value) {
-      throw Error(stack.paths.front().string() + ": " + (max_value == 255 ? "8" : "16") +
-                  "-bit, but the response curve is for " + (used.max_value == 255 ? "8" : "16") +
-                  "-bit images");
+      throw Error(stack.paths.front().string() + ": " + code_range(first) +
+                  ", but the response curve is for codes 0.." + std::to_string(used.max_value));
     }
+    if (is_camera_raw(first)) used = standard_response(Response::kLinear, max_value, first.black);
   } else if (response == Response::kCalibrate) {
     used = calibrate_response(set, base_dir);
   } else {
-    used = standard_response(response, max_value);
+    used = standard_response(response, max_value, first.black);
   }
   std::optional<imaging::RawImage> dark_image;
   if (dark) {
     const fs::path dark_path = resolve(base_dir, *dark);
     dark_image = imaging::read_raw_image(dark_path);
-    const imaging::RawImage& first = stack.images.front();
     if (dark_image->width != first.width || dark_image->height != first.height) {
       throw Error(dark_path.string() + ": dark frame is " +
                   size_text(dark_image->width, dark_image->height) + " pixels but " +
                   stack.paths.front().string() + " is " + size_text(first.width, first.height));
     }
-    if (dark_image->max_value != max_value) {
-      throw Error(dark_path.string() + ": dark frame bit depth differs from " +
-                  stack.paths.front().string());
+    if (dark_image->max_value != max_value || dark_image->black != first.black) {
+      throw Error(dark_path.string() + ": dark frame is " + code_range(*dark_image) + " but " +
+                  stack.paths.front().string() + " is " + code_range(first));
     }
   }
   HdrResult result = merge_stack(stack, used, dark_image);
+  result.exposure_s = stack.exposure_s;
+  result.iso_scaled = stack.iso_known;
+  result.camera_raw = is_camera_raw(first);
   if (dark) result.sources.push_back(resolve(base_dir, *dark));
   return result;
 }

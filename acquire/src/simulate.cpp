@@ -84,8 +84,24 @@ json totals_to_json(const PhotonTransportResult& r) {
   return totals;
 }
 
-std::string bracket_name(const char* stem, std::size_t k) {
-  return std::string(stem) + "_" + std::to_string(k) + ".png";
+const char* extension(BracketFormat format) {
+  return format == BracketFormat::kDng ? ".dng" : ".png";
+}
+
+std::string bracket_name(const char* stem, std::size_t k, BracketFormat format) {
+  return std::string(stem) + "_" + std::to_string(k) + extension(format);
+}
+
+// One bracket in the chosen format; a DNG's capture entry leaves the exposure to its metadata.
+Bracket write_bracket(const std::filesystem::path& dir, const std::string& name,
+                      const imaging::ImageRgb& radiance, double t, double scale,
+                      const CameraOptions& camera, std::uint64_t stream, BracketFormat format) {
+  if (format == BracketFormat::kDng) {
+    imaging::write_dng(dir / name, expose_mosaic(radiance, t, scale, camera, stream));
+    return Bracket(name);
+  }
+  imaging::write_png(dir / name, expose(radiance, t, scale, camera, stream));
+  return Bracket(name, t);
 }
 
 }  // namespace
@@ -157,6 +173,12 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
   CameraOptions camera = options.camera;
   camera.seed = transport.seed;
   if (!options.profile_only) validate_camera_options(camera);
+  if (!options.profile_only && options.bracket_format == BracketFormat::kDng &&
+      (camera.bits != 16 || camera.response != Response::kLinear)) {
+    throw Error(
+        "--bracket-format dng: a RAW sensor records linear 16-bit codes (use --bits 16 "
+        "and --response linear)");
+  }
   validate_photon_transport_options(transport);
   AtomicOutputDir out(out_dir);  // checks the folder can be made before the long simulation
 
@@ -216,12 +238,13 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
       capture.beam_point_px = std::array<double, 2>{transport.size / 2.0, transport.size / 2.0};
     }
     capture.response = camera.response;
+    const BracketFormat format = options.bracket_format;
     std::uint64_t stream = 0;
     for (std::size_t k = 0; k < camera.exposures_s.size(); ++k) {
       const double t = camera.exposures_s[k];
-      const std::string name = bracket_name("bracket", k);
-      imaging::write_png(out.temporary() / name, expose(radiance, t, scale, camera, stream++));
-      capture.sample.images.push_back({name, t});
+      const std::string name = bracket_name("bracket", k, format);
+      capture.sample.images.push_back(
+          write_bracket(out.temporary(), name, radiance, t, scale, camera, stream++, format));
       summary.files.push_back(name);
     }
     json white_json = nullptr;
@@ -238,9 +261,9 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
       reference.reflectance = options.white_reflectance;
       for (std::size_t k = 0; k < camera.exposures_s.size(); ++k) {
         const double t = camera.exposures_s[k] / shorten;
-        const std::string name = bracket_name("white", k);
-        imaging::write_png(out.temporary() / name, expose(white, t, scale, camera, stream++));
-        reference.images.images.push_back({name, t});
+        const std::string name = bracket_name("white", k, format);
+        reference.images.images.push_back(
+            write_bracket(out.temporary(), name, white, t, scale, camera, stream++, format));
         summary.files.push_back(name);
       }
       capture.white_reference = reference;
@@ -250,10 +273,11 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
     }
     if (options.dark_frame) {
       const imaging::ImageRgb black(transport.size, transport.size, 0.0f);
-      imaging::write_png(out.temporary() / "dark.png",
-                         expose(black, camera.exposures_s.back(), scale, camera, stream++));
-      capture.dark = "dark.png";
-      summary.files.push_back("dark.png");
+      const std::string name = std::string("dark") + extension(format);
+      write_bracket(out.temporary(), name, black, camera.exposures_s.back(), scale, camera,
+                    stream++, format);
+      capture.dark = name;
+      summary.files.push_back(name);
     }
     capture.provenance = {{"tool", std::string("lucent simulate ") + kVersion},
                           {"material", options.material.name},
@@ -261,6 +285,7 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
     write_capture(out.temporary() / "capture.json", capture);
     summary.files.push_back("capture.json");
     truth["camera"] = camera_to_json(camera, scale);
+    truth["camera"]["bracket_format"] = format == BracketFormat::kDng ? "dng" : "png";
     truth["white_reference"] = white_json;
     truth["pixel_area_mm2"] = pixel_area;
   }

@@ -18,6 +18,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "lucent/imaging/camera_raw.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
 #include "lucent/materials/json_file.h"
@@ -182,9 +183,12 @@ void write_exr(const std::filesystem::path& path, const ImageRgb& image,
 }
 
 RawImage read_raw_image(const std::filesystem::path& path) {
+  if (is_camera_raw_path(path)) return read_camera_raw(path);
   if (!std::filesystem::exists(path)) throw Error(path.string() + ": no such image file");
   const cv::Mat mat = decode_image_quietly(path, cv::IMREAD_UNCHANGED);
-  if (mat.empty()) throw Error(path.string() + ": cannot read as an image (expected PNG or TIFF)");
+  if (mat.empty())
+    throw Error(path.string() +
+                ": cannot read as an image (expected PNG, TIFF or a camera RAW file)");
   int max_value = 0;
   if (mat.depth() == CV_8U)
     max_value = 255;
@@ -252,8 +256,10 @@ ImageRgb read_any_image(const std::filesystem::path& path) {
   if (ext == ".exr") return read_exr(path);
   const RawImage raw = read_raw_image(path);
   ImageRgb image(raw.width, raw.height);
-  for (std::size_t i = 0; i < raw.data.size(); ++i)
-    image.data[i] = float(raw.data[i]) / raw.max_value;
+  for (std::size_t i = 0; i < raw.data.size(); ++i) {
+    const double black = raw.black[i % 3];
+    image.data[i] = float((raw.data[i] - black) / (raw.max_value - black));
+  }
   return image;
 }
 

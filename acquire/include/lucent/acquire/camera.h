@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "lucent/acquire/capture.h"
+#include "lucent/imaging/camera_raw.h"
 #include "lucent/imaging/image.h"
 
 namespace lucent::acquire {
@@ -43,6 +44,14 @@ double camera_scale(const CameraOptions& options, double peak_radiance);
 /// quantised to the bit depth. `stream` distinguishes images drawn with the same seed.
 imaging::RawImage expose(const imaging::ImageRgb& radiance, double exposure_s, double scale,
                          const CameraOptions& options, std::uint64_t stream);
+
+/// The same camera as a Bayer sensor (RGGB, 16-bit, linear): photosite (2x + i, 2y + j) sees pixel
+/// (x, y) of `radiance` through its colour filter, each with its own noise, so that a RAW reader's
+/// 2 x 2 quads give back the image at its pixel pitch. The pedestal is rounded to a whole code (a
+/// DNG's BlackLevel as LibRaw reads it); exposure_s and ISO 100 go into the mosaic's metadata.
+imaging::BayerMosaic expose_mosaic(const imaging::ImageRgb& radiance, double exposure_s,
+                                   double scale, const CameraOptions& options,
+                                   std::uint64_t stream);
 
 /// The sRGB transfer function and its inverse on [0, 1].
 double srgb_encode(double linear);

@@ -14,8 +14,13 @@ namespace lucent::acquire {
 
 /// One exposure of a bracket.
 struct Bracket {
+  Bracket() = default;
+  Bracket(std::filesystem::path p, double t = 0.0, std::optional<double> i = std::nullopt)
+      : path(std::move(p)), exposure_s(t), iso(i) {}
+
   std::filesystem::path path;  ///< absolute, or relative to the capture file as written
-  double exposure_s = 0.0;     ///< exposure time, s
+  double exposure_s = 0.0;     ///< exposure time, s; 0: read from the camera RAW file's metadata
+  std::optional<double> iso;   ///< ISO speed; absent: from a RAW file's metadata, or unknown
 };
 
 /// How code values map to linear light.
@@ -23,7 +28,9 @@ enum class Response { kLinear, kSrgb, kCalibrate };
 
 /// A stack of brackets or one HDR image (exactly one of the two is set).
 struct ImageSet {
-  std::vector<Bracket> images;               ///< sorted by strictly increasing exposure
+  /// By strictly increasing exposure where the capture gives them (RAW files may leave them to
+  /// their metadata: merge_brackets orders those).
+  std::vector<Bracket> images;
   std::optional<std::filesystem::path> hdr;  ///< linear OpenEXR
 };
 

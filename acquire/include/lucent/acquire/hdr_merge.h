@@ -60,8 +60,10 @@ struct ResponseCurve {
   std::array<std::vector<double>, 3> linear;  ///< [channel][code], max_value + 1 entries each
 };
 
-/// The linear or sRGB curve for `max_value` (kLinear: v / max; kSrgb: srgb_decode(v / max)).
-ResponseCurve standard_response(Response kind, int max_value);
+/// The linear or sRGB curve for codes 0..max_value with a per-channel black level (camera RAW;
+/// 0 for PNG/TIFF): kLinear: (v - black) / (max - black); kSrgb: srgb_decode of the same.
+ResponseCurve standard_response(Response kind, int max_value,
+                                const std::array<double, 3>& black = {0.0, 0.0, 0.0});
 
 /// Recovers the camera response from 8-bit brackets with OpenCV's CalibrateDebevec (up to an
 /// arbitrary scale, shared by everything merged with it). Throws lucent::Error for 16-bit input or
@@ -85,6 +87,11 @@ struct HdrResult {
   NoiseModel noise;
   std::optional<ResponseCurve> response;       ///< the curve used (absent for an 'hdr' input)
   std::vector<std::filesystem::path> sources;  ///< the files read, resolved
+  /// Per bracket, in merge order: the exposure each was divided by, s (times ISO / 100 when
+  /// iso_scaled); empty for an 'hdr' input.
+  std::vector<double> exposure_s;
+  bool iso_scaled = false;   ///< every bracket's ISO was known: radiance is per s at ISO 100
+  bool camera_raw = false;   ///< the brackets were camera RAW files (black and white from them)
   std::string sources_text;  ///< the sample's files in one short phrase, for messages
 
   int width() const { return radiance.width; }

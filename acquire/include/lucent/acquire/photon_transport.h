@@ -152,7 +152,8 @@ PhotonTransportResult simulate_photon_transport(const PhotonTransportOptions& op
 /// The radial exitance as CSV: `#` comment lines with key=value tokens (format, photons, seed, the
 /// geometry, the four totals and their standard errors as R,G,B), then the header
 /// `r_mm,R_r,R_g,R_b,se_r,se_g,se_b,r_inner_mm,r_outer_mm` and one row per bin (r_mm =
-/// area-weighted centre, values mm^-2, the annulus in mm), 17 significant digits. Channels not simulated leave their fields empty.
+/// area-weighted centre, values mm^-2, the annulus in mm), 17 significant digits. Channels not
+/// simulated leave their fields empty.
 std::string exitance_csv(const PhotonTransportResult& result);
 
 }  // namespace lucent::acquire

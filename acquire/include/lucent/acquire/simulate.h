@@ -22,6 +22,11 @@ enum class RadianceSource {
   kDirectionalDipole,  ///< the directional dipole: F_t(in) S_d F_t(out)
 };
 
+/// How the brackets are written: PNG (the camera's encoding, 8 or 16 bits), or DNG (a Bayer
+/// sensor's linear 16-bit codes with black level, exposure time and ISO in the file; the capture
+/// file then leaves exposure_s to the metadata).
+enum class BracketFormat { kPng, kDng };
+
 struct SimulateOptions {
   materials::Material material;
   RadianceSource source = RadianceSource::kMonteCarlo;
@@ -34,6 +39,7 @@ struct SimulateOptions {
   /// imaged. 0 = one pixel pitch.
   double white_spot_sigma_mm = 0;
   bool dark_frame = true;
+  BracketFormat bracket_format = BracketFormat::kPng;
   bool profile_only = false;  ///< skip the images (transport without camera)
   std::optional<std::filesystem::path> exitance_csv;  ///< also write the radial table here
 };

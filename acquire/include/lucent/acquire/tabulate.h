@@ -12,19 +12,20 @@
 namespace lucent::acquire {
 
 struct TabulateOptions {
-  std::vector<double> eta{1.0, 1.1, 1.2, 1.3, 1.4, 1.5, 1.6};  ///< relative indices, each in [1, 2.5]
-  std::vector<double> g{0.0};           ///< Henyey-Greenstein mean cosines, each in [0, 0.99]
+  std::vector<double> eta{1.0, 1.1, 1.2, 1.3,
+                          1.4, 1.5, 1.6};  ///< relative indices, each in [1, 2.5]
+  std::vector<double> g{0.0};              ///< Henyey-Greenstein mean cosines, each in [0, 0.99]
   /// Incidence angles from the normal (degrees, [0, 85]); any > 0 needs grid.phi_bins > 1.
   std::vector<double> incidence_deg{0.0};
   materials::TransportTableGrid grid = materials::default_transport_grid();
-  std::uint64_t photons = 1'000'000;    ///< per slice (rounded up to a multiple of groups)
+  std::uint64_t photons = 1'000'000;  ///< per slice (rounded up to a multiple of groups)
   /// Photons of the white run (the nodes of alpha' >= 0.4) per slice; 0: `photons`. Fewer make
   /// high-g slices affordable (a white path costs 1 / (1 - g) collisions per transport length);
   /// the entries' standard errors say what it costs in noise.
   std::uint64_t white_photons = 0;
   std::uint64_t seed = 1;
-  int threads = 0;                      ///< 0: all cores
-  int groups = 16;                      ///< independent photon groups per slice, >= 2
+  int threads = 0;  ///< 0: all cores
+  int groups = 16;  ///< independent photon groups per slice, >= 2
   /// Paths are cut at this length in units of 1 / sigma_s' (a photon that long has, at the table's
   /// smallest nonzero 1 - alpha', kept less than e^-40 of its weight; only the alpha' = 1 node
   /// loses anything, and only far out).

@@ -2,8 +2,11 @@
 // camera bracket. OpenCV and OpenEXR stay behind image_io.h's implementation.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
+#include <string>
 #include <vector>
 
 namespace lucent::imaging {
@@ -23,12 +26,24 @@ struct ImageRgb {
   bool empty() const { return data.empty(); }
 };
 
-/// A camera bracket as stored: integer code values 0..max_value (255 or 65535), RGB.
+/// What a camera file says about how it was taken (RAW files; PNG/TIFF carry none of it).
+struct ExposureMetadata {
+  std::optional<double> exposure_s;  ///< exposure time, s
+  std::optional<double> iso;         ///< ISO speed
+  std::string camera;                ///< make and model, for messages
+};
+
+/// A camera bracket as stored: integer code values 0..max_value, RGB. PNG/TIFF: max_value 255 or
+/// 65535 and no black level. Camera RAW (camera_raw.h): max_value is the sensor's white level and
+/// `black` its per-channel black level, both in codes; linear light is (v - black) / (max - black).
 struct RawImage {
   int width = 0;
   int height = 0;
-  int max_value = 255;  ///< 255 for 8-bit, 65535 for 16-bit files
+  int max_value =
+      255;  ///< the code at which the sensor saturates (255, 65535 or a RAW white level)
+  std::array<double, 3> black{0.0, 0.0, 0.0};  ///< code of no light, per channel
   std::vector<std::uint16_t> data;
+  ExposureMetadata metadata;
 
   RawImage() = default;
   RawImage(int w, int h, int max)

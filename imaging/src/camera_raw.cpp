@@ -1,0 +1,231 @@
+#include "lucent/imaging/camera_raw.h"
+
+#include <libraw/libraw.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <memory>
+#include <set>
+
+#include "lucent/materials/error.h"
+#include "lucent/materials/json_file.h"
+
+namespace lucent::imaging {
+namespace {
+
+// As for the other readers: at most 16384 x 16384 pixels out (a RAW sensor twice that).
+constexpr long long kMaxSensorPixels = 4ll << 28;
+constexpr std::size_t kMaxRawFileBytes = std::size_t(1) << 30;
+
+std::string lower_extension(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char ch) { return char(std::tolower(ch)); });
+  return ext;
+}
+
+// LibRaw reports damaged data through a callback that prints by default: keep the first message
+// for lucent's own error line instead.
+void note_data_error(void* context, const char*, const int offset) {
+  auto* message = static_cast<std::string*>(context);
+  if (message->empty()) {
+    *message =
+        offset < 0 ? "unexpected end of file" : "corrupt data near byte " + std::to_string(offset);
+  }
+}
+
+// The channel (0 R, 1 G, 2 B) of LibRaw's colour index, or -1 for a colour lucent cannot use.
+int channel_of(const libraw_iparams_t& idata, int colour) {
+  if (colour < 0 || colour > 3) return -1;
+  switch (idata.cdesc[colour]) {
+    case 'R':
+      return 0;
+    case 'G':
+      return 1;
+    case 'B':
+      return 2;
+    default:
+      return -1;
+  }
+}
+
+// Black level of the photosite at visible (row, col) of colour index `colour`: the common part,
+// the per-colour part and the repeating pattern (LibRaw's cblack[4] x cblack[5] at cblack[6]).
+double black_at(const libraw_colordata_t& color, int colour, int row, int col) {
+  double black = double(color.black) + double(color.cblack[colour]);
+  const unsigned rows = color.cblack[4], cols = color.cblack[5];
+  if (rows > 0 && cols > 0) black += color.cblack[6 + (row % rows) * cols + (col % cols)];
+  return black;
+}
+
+std::string camera_name(const libraw_iparams_t& idata) {
+  std::string name = std::string(idata.make) + " " + std::string(idata.model);
+  while (!name.empty() && name.back() == ' ') name.pop_back();
+  return name.empty() ? "unknown camera" : name;
+}
+
+RawImage read_bayer(LibRaw& raw, const std::string& name) {
+  const libraw_image_sizes_t& s = raw.imgdata.sizes;
+  const libraw_iparams_t& idata = raw.imgdata.idata;
+  const libraw_colordata_t& color = raw.imgdata.color;
+  // A 2 x 2 mosaic repeats every two rows and columns: LibRaw's 8-row pattern must agree.
+  for (int row = 0; row < 8; ++row) {
+    for (int col = 0; col < 2; ++col) {
+      if (raw.COLOR(row, col) != raw.COLOR(row % 2, col)) {
+        throw Error(name +
+                    ": the colour filter pattern does not repeat every 2 x 2 photosites "
+                    "(lucent reads 2 x 2 Bayer sensors)");
+      }
+    }
+  }
+  if (color.cblack[4] > 2 || color.cblack[5] > 2) {
+    throw Error(name + ": black-level pattern of " + std::to_string(color.cblack[4]) + " x " +
+                std::to_string(color.cblack[5]) + " photosites (lucent supports up to 2 x 2)");
+  }
+  // Which photosite of the quad gives which channel, and each channel's black level.
+  std::array<int, 4> channel{};
+  std::array<int, 3> sites{};
+  std::array<double, 3> black{};
+  for (int q = 0; q < 4; ++q) {
+    const int row = q / 2, col = q % 2, colour = raw.COLOR(row, col);
+    channel[q] = channel_of(idata, colour);
+    if (channel[q] < 0) {
+      throw Error(name + ": colour filter '" + std::string(1, idata.cdesc[colour % 4]) +
+                  "' is not red, green or blue (lucent reads RGB Bayer sensors)");
+    }
+    ++sites[channel[q]];
+    black[channel[q]] += black_at(color, colour, row, col);
+  }
+  if (sites[0] != 1 || sites[1] != 2 || sites[2] != 1) {
+    throw Error(name + ": the 2 x 2 quad is not one red, two green and one blue photosite");
+  }
+  for (int c = 0; c < 3; ++c) black[c] /= sites[c];
+
+  const int w = s.width / 2, h = s.height / 2;
+  const int white = int(std::min<unsigned>(color.maximum, 65535));
+  RawImage image(w, h, white);
+  image.black = black;
+  const std::uint16_t* data = raw.imgdata.rawdata.raw_image;
+  const std::size_t pitch = s.raw_pitch / sizeof(std::uint16_t);
+  const auto code = [&](int row, int col) -> int {
+    const int v = data[std::size_t(row + s.top_margin) * pitch + std::size_t(col + s.left_margin)];
+    return std::min(v, white);
+  };
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      int green_sum = 0;
+      bool green_saturated = false;
+      for (int q = 0; q < 4; ++q) {
+        const int v = code(2 * y + q / 2, 2 * x + q % 2);
+        if (channel[q] == 1) {
+          green_sum += v;
+          green_saturated = green_saturated || v >= white - 1;
+        } else {
+          image.at(x, y, channel[q]) = std::uint16_t(v);
+        }
+      }
+      image.at(x, y, 1) = std::uint16_t(green_saturated ? white : (green_sum + 1) / 2);
+    }
+  }
+  return image;
+}
+
+// A linear DNG: three (or four, the fourth unused) samples per pixel, already interpolated by
+// whatever wrote it.
+RawImage read_linear(LibRaw& raw, const std::string& name) {
+  const libraw_image_sizes_t& s = raw.imgdata.sizes;
+  const libraw_colordata_t& color = raw.imgdata.color;
+  const libraw_rawdata_t& rd = raw.imgdata.rawdata;
+  const int samples = rd.color3_image ? 3 : 4;
+  const std::uint16_t* data = rd.color3_image ? &rd.color3_image[0][0] : &rd.color4_image[0][0];
+  const int white = int(std::min<unsigned>(color.maximum, 65535));
+  RawImage image(s.width, s.height, white);
+  for (int c = 0; c < 3; ++c) {
+    image.black[c] = black_at(color, c, 0, 0);
+    if (color.cblack[4] > 1 || color.cblack[5] > 1) {
+      throw Error(name + ": linear DNG with a black-level pattern (not supported)");
+    }
+  }
+  const std::size_t pitch = s.raw_pitch / sizeof(std::uint16_t);
+  for (int y = 0; y < s.height; ++y) {
+    for (int x = 0; x < s.width; ++x) {
+      const std::uint16_t* px =
+          data + std::size_t(y + s.top_margin) * pitch + std::size_t(x + s.left_margin) * samples;
+      for (int c = 0; c < 3; ++c) image.at(x, y, c) = std::uint16_t(std::min<int>(px[c], white));
+    }
+  }
+  return image;
+}
+
+}  // namespace
+
+bool is_camera_raw_path(const std::filesystem::path& path) {
+  static const std::set<std::string> kExtensions = {
+      ".dng", ".cr2", ".cr3", ".crw", ".nef", ".nrw", ".arw", ".srf", ".sr2", ".raf", ".orf",
+      ".rw2", ".pef", ".srw", ".3fr", ".iiq", ".erf", ".kdc", ".mos", ".mrw", ".x3f"};
+  return kExtensions.count(lower_extension(path)) > 0;
+}
+
+RawImage decode_camera_raw(std::string_view bytes, const std::string& name) {
+  // LibRaw's object holds large buffers: on the heap, one per call (thread-safe libraw_r).
+  auto raw = std::make_unique<LibRaw>(LIBRAW_OPTIONS_NONE);
+  std::string data_error;
+  raw->set_dataerror_handler(note_data_error, &data_error);
+  const auto fail = [&](const std::string& what, int code) {
+    std::string line = name + ": " + what;
+    if (code != LIBRAW_SUCCESS) line += " (" + std::string(libraw_strerror(code)) + ")";
+    if (!data_error.empty()) line += ": " + data_error;
+    throw Error(line);
+  };
+  int rc = raw->open_buffer(const_cast<char*>(bytes.data()), bytes.size());
+  if (rc != LIBRAW_SUCCESS) fail("not a camera RAW file LibRaw can read", rc);
+  const libraw_image_sizes_t& s = raw->imgdata.sizes;
+  if (s.width < 2 || s.height < 2) fail("RAW image has no pixels", LIBRAW_SUCCESS);
+  if (static_cast<long long>(s.raw_width) * s.raw_height > kMaxSensorPixels) {
+    fail("the RAW sensor is larger than 32768 x 32768 photosites", LIBRAW_SUCCESS);
+  }
+  rc = raw->unpack();
+  if (rc != LIBRAW_SUCCESS) fail("cannot decode the RAW data", rc);
+  if (!data_error.empty()) fail("damaged RAW data", LIBRAW_SUCCESS);
+
+  const libraw_iparams_t& idata = raw->imgdata.idata;
+  const libraw_colordata_t& color = raw->imgdata.color;
+  const libraw_rawdata_t& rd = raw->imgdata.rawdata;
+  if (color.maximum == 0 || color.maximum > 65535) {
+    fail("no usable white level (maximum " + std::to_string(color.maximum) + ")", LIBRAW_SUCCESS);
+  }
+  RawImage image;
+  if (rd.raw_image && idata.filters >= 1000) {
+    image = read_bayer(*raw, name);
+  } else if (!rd.raw_image && (rd.color3_image || rd.color4_image) && idata.colors == 3) {
+    image = read_linear(*raw, name);
+  } else {
+    fail("sensor layout not supported (" + camera_name(idata) +
+             (idata.filters == 9 ? ": X-Trans"
+              : idata.filters    ? ": non-Bayer mosaic"
+                                 : "") +
+             "; lucent reads 2 x 2 RGB Bayer RAW files and linear DNGs)",
+         LIBRAW_SUCCESS);
+  }
+  for (int c = 0; c < 3; ++c) {
+    if (!(image.black[c] < image.max_value - 1)) {
+      fail("black level " + std::to_string(image.black[c]) + " is not below the white level " +
+               std::to_string(image.max_value),
+           LIBRAW_SUCCESS);
+    }
+  }
+  const libraw_imgother_t& other = raw->imgdata.other;
+  if (other.shutter > 0 && std::isfinite(other.shutter)) image.metadata.exposure_s = other.shutter;
+  if (other.iso_speed > 0 && std::isfinite(other.iso_speed)) image.metadata.iso = other.iso_speed;
+  image.metadata.camera = camera_name(idata);
+  return image;
+}
+
+RawImage read_camera_raw(const std::filesystem::path& path) {
+  if (!std::filesystem::exists(path)) throw Error(path.string() + ": no such image file");
+  const std::string bytes = read_input_file(path, kMaxRawFileBytes);
+  return decode_camera_raw(bytes, path.string());
+}
+
+}  // namespace lucent::imaging
