@@ -3,7 +3,8 @@
 # libFuzzer exit non-zero and the test fail; the reproducer is left as crash-* in the build folder.
 file(MAKE_DIRECTORY ${CORPUS})
 foreach(dir ${SEEDS})
-  file(GLOB_RECURSE seeds "${dir}/*.json" "${dir}/*.csv" "${dir}/*.ply" "${dir}/*.obj")
+  file(GLOB_RECURSE seeds "${dir}/*.json" "${dir}/*.csv" "${dir}/*.ply" "${dir}/*.obj"
+                            "${dir}/*.dng")
   foreach(seed ${seeds})
     file(SIZE ${seed} bytes)
     if(bytes LESS 1048576)

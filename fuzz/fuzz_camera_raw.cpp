@@ -1,0 +1,24 @@
+// libFuzzer target: lucent's camera RAW reader (LibRaw underneath, then lucent's quad binning and
+// level checks), on arbitrary bytes. Seeds: fuzz/seeds/raw, DNGs written by write_dng for
+// tests/imaging/camera_raw_test.cpp (a 48 x 32 RGGB mosaic with EXIF exposure and ISO, and a
+// 24 x 24 one without).
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+#include "lucent/imaging/camera_raw.h"
+#include "lucent/materials/error.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string_view bytes(reinterpret_cast<const char*>(data), size);
+  try {
+    const lucent::imaging::RawImage image = lucent::imaging::decode_camera_raw(bytes, "fuzz.dng");
+    // What the merge relies on: one code per pixel and channel, none above the white level.
+    if (image.data.size() != std::size_t(image.width) * image.height * 3) __builtin_trap();
+    for (std::uint16_t v : image.data) {
+      if (v > image.max_value) __builtin_trap();
+    }
+  } catch (const lucent::Error&) {
+  }
+  return 0;
+}
