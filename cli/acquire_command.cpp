@@ -3,10 +3,11 @@
 #include <memory>
 
 #include "commands.h"
-#include "validators.h"
 #include "lucent/acquire/acquire.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
+#include "progress.h"
+#include "validators.h"
 
 namespace lucent::cli {
 namespace {
@@ -16,7 +17,7 @@ struct AcquireArguments {
   std::string output;
   acquire::AcquireOptions options;
   double radius_mm = 0;
-  bool json = false, force = false;
+  bool json = false, force = false, quiet = false;
 };
 
 }  // namespace
@@ -54,11 +55,17 @@ void register_acquire_command(CLI::App& app) {
          "drop radial bins with fewer unmasked pixels than this in any channel (default 3)")
       ->check(whole_in(2, 1000000000, "pixels per bin"));
   cmd->add_flag("--json", args->json, "print the summary as JSON on standard output");
+  cmd->add_flag("-q,--quiet", args->quiet, "no progress on standard error");
   cmd->callback([args, radius] {
     set_replace_folders(args->force);
     if (radius->count() > 0) args->options.radius_mm = args->radius_mm;
+    StageProgress progress("acquire", args->quiet);
+    args->options.progress = [&](const std::string& stage, double done) {
+      progress.stage(stage, done);
+    };
     const acquire::AcquireSummary summary =
         acquire::run_acquire(args->capture, args->output, args->options);
+    progress.finish();
     if (args->json) {
       std::cout << acquire::summary_to_json(summary).dump(2) << '\n';
     } else {

@@ -6,11 +6,15 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdint>
 #include <cstdio>
+#include <mutex>
 #include <string>
+#include <thread>
 
 namespace lucent::cli {
 
@@ -27,8 +31,11 @@ class ProgressLine {
  public:
   /// `what`: the command's name; `unit`: what is counted ("photons"). Quiet: prints nothing.
   ProgressLine(std::string what, std::string unit, bool quiet)
-      : what_(std::move(what)), unit_(std::move(unit)), quiet_(quiet),
-        terminal_(::isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()),
+      : what_(std::move(what)),
+        unit_(std::move(unit)),
+        quiet_(quiet),
+        terminal_(::isatty(STDERR_FILENO) != 0),
+        start_(std::chrono::steady_clock::now()),
         last_(start_) {}
 
   void update(std::uint64_t done, std::uint64_t total) {
@@ -62,6 +69,76 @@ class ProgressLine {
   std::chrono::steady_clock::time_point start_, last_;
   int last_tenth_ = 0;
   bool drawn_ = false;
+};
+
+/// Progress of a command made of stages (acquire, view's start-up): `stage(name, done)` says which
+/// stage starts and the share of the work done before it. On a terminal a ticker redraws
+/// "acquire: merging the sample brackets, 40%, 3 s left" once a second (after the first second,
+/// so that it keeps moving through a long stage); elsewhere one line per stage begun after the
+/// first second. Thread-safe.
+class StageProgress {
+ public:
+  StageProgress(std::string what, bool quiet)
+      : what_(std::move(what)),
+        quiet_(quiet),
+        terminal_(::isatty(STDERR_FILENO) != 0),
+        start_(std::chrono::steady_clock::now()) {
+    if (!quiet_ && terminal_) ticker_ = std::thread([this] { tick(); });
+  }
+  ~StageProgress() { finish(); }
+  StageProgress(const StageProgress&) = delete;
+  StageProgress& operator=(const StageProgress&) = delete;
+
+  void stage(const std::string& name, double done) {
+    if (quiet_) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    stage_ = name;
+    done_ = std::clamp(done, 0.0, 1.0);
+    if (!terminal_ && elapsed() >= 1.0) {
+      std::fprintf(stderr, "%s: %s (%d%% done, %s so far)\n", what_.c_str(), name.c_str(),
+                   int(100 * done_), duration_text(elapsed()).c_str());
+      std::fflush(stderr);
+    }
+  }
+  /// Stops the ticker and clears a terminal's line (call before printing the result).
+  void finish() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (stopped_) return;
+      stopped_ = true;
+    }
+    wake_.notify_all();
+    if (ticker_.joinable()) ticker_.join();
+    if (drawn_) std::fprintf(stderr, "\r%s\r", std::string(78, ' ').c_str());
+  }
+
+ private:
+  double elapsed() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+  void tick() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (!wake_.wait_for(lock, std::chrono::seconds(1), [this] { return stopped_; })) {
+      if (stage_.empty()) continue;
+      const double t = elapsed();
+      const std::string left =
+          done_ > 0.02 ? ", " + duration_text(t * (1 - done_) / done_) + " left" : "";
+      std::fprintf(stderr, "\r%s: %s, %d%%%s   ", what_.c_str(), stage_.c_str(), int(100 * done_),
+                   left.c_str());
+      std::fflush(stderr);
+      drawn_ = true;
+    }
+  }
+
+  std::string what_;
+  bool quiet_, terminal_;
+  std::chrono::steady_clock::time_point start_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::thread ticker_;
+  std::string stage_;
+  double done_ = 0;
+  bool stopped_ = false, drawn_ = false;
 };
 
 }  // namespace lucent::cli

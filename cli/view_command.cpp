@@ -1,14 +1,16 @@
 // `lucent view`: the same scene options as `lucent render`, shown in a window with live controls
-// (lucent::render::run_viewer). Needs an X display; `xvfb-run -a lucent view ...` gives a virtual one.
+// (lucent::render::run_viewer). Needs an X display; `xvfb-run -a lucent view ...` gives a virtual
+// one.
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <cstdio>
 #include <memory>
 #include <string>
 
 #include "commands.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
+#include "progress.h"
 #include "scene_options.h"
 #if LUCENT_HAS_VIEWER
 #include "lucent/render/viewer.h"
@@ -32,7 +34,10 @@ void run_view(ViewArguments& args) {
   // The maps' shader cache is of no use for one short session and fails on read-only homes.
   setenv("MESA_SHADER_CACHE_DISABLE", "true", 0);
   const bool model_given = !args.scene.model.empty();
+  StageProgress progress("view", false);
+  progress.stage("loading the scene (mesh, material, lights)", 0.0);
   SceneSetup setup = build_scene(args.scene);
+  progress.finish();
   render::ViewerOptions options;
   options.scene = std::move(setup.scene);
   options.material_source = args.scene.material;
@@ -88,12 +93,13 @@ void register_view_command(CLI::App& app) {
                   "at most 0.2); the mesh moves every frame and the maps restart with it")
       ->capture_default_str();
   cmd->add_flag("--hide-panel", args->hide_panel, "start without the panel (H shows it)");
-  cmd->add_option("--script", args->script,
-                  "actions, one per frame, separated by ';': orbit DX DY, light DX DY (pixels), "
-                  "zoom STEPS, set NAME VALUE (N M q K Ws Wl T exposure size deform technique "
-                  "model), key LETTER, wait FRAMES, sleep SECONDS, settle (until the maps converge or the "
-                  "reference has a pass), screenshot FILE.png, panel on|off, difference on|off, restart, "
-                  "quit");
+  cmd->add_option(
+      "--script", args->script,
+      "actions, one per frame, separated by ';': orbit DX DY, light DX DY (pixels), "
+      "zoom STEPS, set NAME VALUE (N M q K Ws Wl T exposure size deform technique "
+      "model), key LETTER, wait FRAMES, sleep SECONDS, settle (until the maps converge or the "
+      "reference has a pass), screenshot FILE.png, panel on|off, difference on|off, restart, "
+      "quit");
   cmd->callback([args] { run_view(*args); });
 }
 

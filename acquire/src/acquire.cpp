@@ -221,6 +221,12 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
   validate(options);
   const Capture capture = read_capture(capture_json);
   AtomicOutputDir out(out_dir);  // checks the folder can be made; removed again unless committed
+  // Stage weights: rough shares of the time on a large capture (the merges dominate).
+  const auto progress = [&](const char* stage, double done) {
+    if (options.progress) options.progress(stage, done);
+  };
+  const bool white_given = capture.white_reference.has_value();
+  progress("merging the sample's brackets", 0.0);
 
   // Sample: one response for everything (a recovered curve is shared with the white reference).
   std::optional<ResponseCurve> curve;
@@ -257,6 +263,7 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
   summary.beam_power_source = "none";
   if (capture.white_reference) {
     const WhiteReference& reference = *capture.white_reference;
+    progress("merging the white reference", 0.45);
     const HdrResult white =
         merge_brackets(reference.images, capture.response, capture.dark, capture.base_dir, curve);
     if (white.iso_scaled != hdr.iso_scaled) {
@@ -309,6 +316,7 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
   binning.min_pixels_per_bin = options.min_pixels_per_bin;
   const std::vector<double> edges = radial_bin_edges_mm(binning, capture.pixel_pitch_mm);
 
+  progress("binning the profile", white_given ? 0.8 : 0.6);
   Profile profile;
   profile.calibrated = summary.calibrated;
   profile.capture = capture_json.string();
@@ -404,6 +412,7 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
        "0 where masked (saturated or black in every bracket, or non-finite); "
        "counts in profile.json"},
       {"lucent.capture", capture_json.string()}};
+  progress("writing", 0.92);
   imaging::write_exr(out.temporary() / "capture.exr", radiance, attributes);
   write_profile(out.temporary() / "profile.json", profile);
   write_file_atomically(out.temporary() / "profile.csv", profile_csv(profile));

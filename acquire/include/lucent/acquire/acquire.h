@@ -8,6 +8,7 @@
 
 #include <array>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,6 +30,8 @@ struct AcquireOptions {
       3;  ///< bins with fewer unmasked pixels (in any channel) are dropped; >= 2
   BeamDetectionOptions beam;  ///< used unless the capture gives beam_point_px
   int ring_every_bins = 10;   ///< acquire.png draws a ring at every n-th bin edge
+  /// Called as each stage starts, with its name and the share of the work done before it.
+  std::function<void(const std::string& stage, double done)> progress;
 };
 
 struct AcquireSummary {
