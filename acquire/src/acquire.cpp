@@ -10,6 +10,7 @@
 #include "lucent/acquire/camera.h"
 #include "lucent/acquire/capture.h"
 #include "lucent/acquire/hdr_merge.h"
+#include "lucent/imaging/camera_raw.h"
 #include "lucent/imaging/image_io.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
@@ -365,7 +366,8 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
     provenance["exposures_s"] = hdr.exposure_s;
     if (hdr.iso_scaled) provenance["exposures_scaled_by"] = "ISO / 100";
     if (hdr.camera_raw) {
-      provenance["camera_raw"] = "2x2 Bayer quads, black and white levels from the files";
+      provenance["camera_raw"] = "2x2 Bayer quads, black and white levels from the files (" +
+                                 imaging::camera_raw_decoder_version() + ")";
     }
   }
   if (detected) {

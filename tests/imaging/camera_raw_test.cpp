@@ -162,6 +162,33 @@ TEST(CameraRaw, DamagedFilesGiveOneLineNamingTheFile) {
   }
 }
 
+// tests/imaging/data/libraw_0.20_abort.dng: 2.7 KB that a libFuzzer run of LibRaw's open_buffer
+// and unpack (seeded with fuzz/seeds/raw) turned into a file LibRaw 0.20 aborts on (a fortified
+// strcat overflow in its Hasselblad model parser). lucent decodes RAW in a child process: the
+// abort is one error line, and this test process lives on to read a good file after it.
+TEST(CameraRaw, ADecoderCrashIsOneErrorLineNotACrash) {
+  const fs::path crafted = fs::path(LUCENT_TEST_DATA_DIR) / "data" / "libraw_0.20_abort.dng";
+  ASSERT_TRUE(fs::exists(crafted));
+  std::string message;
+  try {
+    const RawImage image = read_camera_raw(crafted);
+    // A LibRaw that no longer crashes may read something: then it must be self-consistent.
+    EXPECT_EQ(image.data.size(), std::size_t(image.width) * image.height * 3);
+  } catch (const Error& e) {
+    message = e.what();
+  }
+  if (camera_raw_decoder_version().rfind("LibRaw 0.20", 0) == 0) {
+    EXPECT_NE(message.find("crashed on this file (signal"), std::string::npos) << message;
+  }
+  if (!message.empty()) {
+    EXPECT_NE(message.find(crafted.string()), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
+  const fs::path good = scratch("after_crash.dng");
+  write_dng(good, test_mosaic(32, 32, {0, 1, 1, 2}, 64, 4095));
+  EXPECT_EQ(read_camera_raw(good).width, 16);
+}
+
 TEST(CameraRaw, WriterRefusesImpossibleMosaics) {
   BayerMosaic odd = test_mosaic(4, 4, {0, 1, 1, 2}, 10, 100);
   odd.width = 3;

@@ -12,6 +12,10 @@
 // tail stays unbiased. Pixels are in sensor orientation (the camera's rotation flag is ignored).
 // Linear DNGs (three samples per pixel) are read pixel for pixel. X-Trans and other non-2 x 2
 // mosaics, and black-level patterns larger than 2 x 2, are refused.
+//
+// LibRaw runs in a forked child process for every file: a RAW file is untrusted input, and LibRaw
+// (Debian's 0.20) aborts on some crafted files. A crash or a hang (120 s) of the child becomes one
+// error line naming the file; lucent itself never crashes on a RAW file.
 #pragma once
 
 #include <array>
@@ -34,8 +38,11 @@ bool is_camera_raw_path(const std::filesystem::path& path);
 /// LibRaw cannot read, a sensor layout lucent does not support, or an image over 16384^2 pixels.
 RawImage read_camera_raw(const std::filesystem::path& path);
 
-/// The same from bytes in memory (`name` is used in messages).
+/// The same from bytes in memory (`name` is used in messages), LibRaw isolated in a child process.
 RawImage decode_camera_raw(std::string_view bytes, const std::string& name);
+
+/// The RAW decoder lucent runs, for provenance: "LibRaw 0.20.2".
+std::string camera_raw_decoder_version();
 
 /// A Bayer mosaic as a sensor records it: one code per photosite, row-major.
 struct BayerMosaic {
