@@ -35,6 +35,7 @@ struct FitArguments {
   bool row_ior = false;  // a batch row gave ior
   std::uint64_t oblique_photons = 1'000'000;
   bool fit_ior = false, relative = false, json = false, allow_unconverged = false;
+  bool plot_log_r = false;  // --plot-log-r
 };
 
 fit::FitOptions to_options(const FitArguments& a) {
@@ -97,7 +98,10 @@ materials::Material run(const FitArguments& a) {
   fit::FitOptions options = to_options(a);
   // Where the outputs go is checked before the fit (they are written together at the end).
   check_output_file(a.output, ".json", "-o");
-  if (!a.plot.empty()) check_output_file(a.plot, ".png", "--plot");
+  if (!a.plot.empty()) {
+    check_output_file(a.plot, "", "--plot");
+    fit::check_fit_plot_path(a.plot, "--plot");
+  }
   if (!a.report.empty()) check_output_file(a.report, ".json", "--report");
   std::vector<fit::ProfileData> data;
   for (const std::string& input : a.inputs) {
@@ -120,7 +124,11 @@ materials::Material run(const FitArguments& a) {
   if (name.empty()) name = std::filesystem::path(a.output).stem().string();
   const materials::Material material = fit::fitted_material(result, data, options, name);
   // Everything is computed before anything is written; each file is written atomically.
-  if (!a.plot.empty()) fit::write_fit_plot(a.plot, result, data.front());
+  if (!a.plot.empty()) {
+    fit::FitPlotOptions plot_options;
+    plot_options.log_r = a.plot_log_r;
+    fit::write_fit_plot(a.plot, result, data.front(), plot_options);
+  }
   if (!a.report.empty()) {
     const nlohmann::json report = fit::fit_report(result, data, options);
     check_finite_json(report, a.report);
@@ -289,7 +297,10 @@ void register_fit_command(CLI::App& app) {
          "--quality", args->quality,
          "fast, balanced or accurate: footprint quadrature order, samples used, tolerances")
       ->capture_default_str();
-  cmd->add_option("--plot", args->plot, "write the fit plot (PNG)");
+  cmd->add_option("--plot", args->plot,
+                  "write the fit plot: profile, residuals and, for 2D samples, residual maps "
+                  "(.svg, .pdf or .png, by the extension)");
+  cmd->add_flag("--plot-log-r", args->plot_log_r, "the fit plot's r axis logarithmic");
   cmd->add_option("--report", args->report, "write everything per channel (JSON)");
   cmd->add_option("--name", args->name, "material name (default: the output file's stem)");
   cmd->add_flag("--allow-unconverged", args->allow_unconverged,

@@ -54,17 +54,12 @@ double median(std::vector<double> v) {
 
 int run_fit_bench(const FitBenchOptions& options, std::ostream& log) {
   if (options.repeats < 1) throw Error("--repeats: expected at least 1");
-  const fs::path scratch =
-      fs::temp_directory_path() / ("lucent-bench-fit-" + std::to_string(::getpid()));
-  fs::remove_all(scratch);
-  fs::create_directories(scratch);
-  struct Cleanup {
-    fs::path dir;
-    ~Cleanup() {
-      std::error_code ec;
-      fs::remove_all(dir, ec);
-    }
-  } cleanup{scratch};
+  // Scratch captures live in a temporary output folder that is never committed: files written
+  // inside it appear at once (the command's transaction defers only the real outputs), and it is
+  // removed on return, on an error and on SIGINT/SIGTERM.
+  const AtomicOutputDir scratch_dir(fs::temp_directory_path() /
+                                    ("lucent-bench-fit-" + std::to_string(::getpid())));
+  const fs::path& scratch = scratch_dir.temporary();
 
   std::vector<BenchCase> cases;
   log << "bench fit: preparing captures\n";
@@ -151,25 +146,34 @@ int run_fit_bench(const FitBenchOptions& options, std::ostream& log) {
   write_file_atomically(options.out_dir / "fit_tradeoff.csv", csv.str());
   imaging::PlotPanel panel;
   panel.title =
-      "fit speed against accuracy: mean relative parameter error vs median solve time "
-      "(fast, balanced, accurate joined)";
-  panel.x_label = "time per fit (ms, log)";
-  panel.log_x = panel.log_y = true;
-  const std::array<std::array<std::uint8_t, 3>, 12> palette{{{200, 30, 30},
-                                                             {30, 140, 30},
-                                                             {30, 60, 210},
-                                                             {200, 120, 0},
-                                                             {140, 0, 160},
-                                                             {0, 150, 150},
-                                                             {90, 90, 90},
-                                                             {220, 0, 120},
-                                                             {120, 80, 20},
-                                                             {0, 90, 60},
-                                                             {100, 100, 230},
-                                                             {230, 160, 160}}};
+      "Fit speed against accuracy: mean relative parameter error against median solve time, "
+      "one curve per case and model through fast, balanced and accurate";
+  panel.x_label = "time per fit (ms)";
+  panel.y_label = "mean relative error of σ_a and σ_s'";
+  // Logarithmic where the values span decades (they usually do).
+  double t_lo = INFINITY, t_hi = 0, e_lo = INFINITY, e_hi = 0;
+  for (const Point& p : points) {
+    t_lo = std::min(t_lo, p.time_ms), t_hi = std::max(t_hi, p.time_ms);
+    e_lo = std::min(e_lo, p.error), e_hi = std::max(e_hi, p.error);
+  }
+  panel.log_x = t_lo > 0 && t_hi > 20 * t_lo;
+  panel.log_y = e_lo > 0 && e_hi > 20 * e_lo;
+  const std::array<std::array<std::uint8_t, 3>, 8> palette{{{200, 30, 30},
+                                                            {30, 140, 30},
+                                                            {30, 60, 210},
+                                                            {200, 120, 0},
+                                                            {140, 0, 160},
+                                                            {0, 150, 150},
+                                                            {90, 90, 90},
+                                                            {220, 0, 120}}};
+  const std::array<imaging::Marker, 4> markers{imaging::Marker::kCircle, imaging::Marker::kSquare,
+                                               imaging::Marker::kTriangle,
+                                               imaging::Marker::kDiamond};
   for (std::size_t s = 0; s < series_names.size(); ++s) {
     imaging::PlotSeries series;
     series.rgb = palette[s % palette.size()];
+    series.marker = markers[s % markers.size()];
+    series.dashed = s >= palette.size();
     series.line = true;
     series.label = series_names[s];
     for (const Point& p : points) {
@@ -177,11 +181,13 @@ int run_fit_bench(const FitBenchOptions& options, std::ostream& log) {
     }
     panel.series.push_back(series);
   }
-  imaging::write_plot_png(
-      options.out_dir / "fit_tradeoff.png", {panel},
-      {"error: mean over channels of |fitted / truth - 1| for sigma_a and sigma_s', averaged",
-       "model-made captures have an exact truth for their model; the Monte Carlo one has none"},
-      1100, 700);
+  imaging::PlotFigure figure;
+  figure.panels = {panel};
+  figure.footer = {
+      "error: mean over channels of |fitted / truth - 1| for σ_a and σ_s', averaged; "
+      "model-made captures have an exact truth for their model, the Monte Carlo one has none"};
+  figure.width = 1100, figure.height = 700;
+  imaging::write_plot(options.out_dir / "fit_tradeoff.png", figure);
   return settings;
 }
 

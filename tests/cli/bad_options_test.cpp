@@ -98,6 +98,7 @@ std::vector<BadCase> option_cases() {
       {"fit_output_is_folder", nullptr, "fit {world}/acq/profile.json -o {dir}", "-o"},
       {"fit_output_empty", nullptr, "fit {world}/acq/profile.json -o ''", "-o"},
       {"fit_plot_not_png", nullptr, fit + "--plot {dir}/f.json", "--plot"},
+      {"fit_plot_txt", nullptr, fit + "--plot {dir}/fit.txt", ".svg, .pdf or .png"},
       // a warning of the work (dragon:4's non-manifold edges) does not join the error line
       {"render_dragon_bad_env", nullptr,
        "render --material marble --mesh dragon:4 --technique reference --size 8x8 "

@@ -48,6 +48,24 @@ TEST(FitCommand, FitsACsvProfileAndWritesMaterialPlotAndReport) {
   fs::remove_all(dir);
 }
 
+TEST(FitCommand, WritesThePlotInTheFormatOfItsExtension) {
+  const fs::path dir = scratch_dir("fit-plot-formats");
+  write_csv(dir / "p.csv", good_csv());
+  const std::string fit = "fit \"" + (dir / "p.csv").string() +
+                          "\" --ior 1.5 --model dipole --exclude-radius-mm 0 -o \"" +
+                          (dir / "m.json").string() + "\" --plot \"";
+  auto r = run_lucent(fit + (dir / "fit.svg").string() + "\"");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string svg = read_text(dir / "fit.svg");
+  EXPECT_EQ(svg.rfind("<?xml", 0), 0u);
+  EXPECT_NE(svg.find("<svg"), std::string::npos);
+  EXPECT_NE(svg.find("R fit"), std::string::npos);  // the legend, kept as the SVG's <desc>
+  r = run_lucent(fit + (dir / "fit.PDF").string() + "\" --plot-log-r");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(read_text(dir / "fit.PDF").rfind("%PDF", 0), 0u);
+  fs::remove_all(dir);
+}
+
 struct BadFit {
   const char* name;
   std::string csv;   // written to in.csv ("" = do not write)
