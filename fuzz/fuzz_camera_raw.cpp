@@ -1,9 +1,10 @@
 // libFuzzer target: lucent's camera RAW reader (LibRaw underneath, then lucent's quad binning and
 // level checks), on arbitrary bytes. Seeds: fuzz/seeds/raw, DNGs written by write_dng for
 // tests/imaging/camera_raw_test.cpp (a 48 x 32 RGGB mosaic with EXIF exposure and ISO, and a
-// 24 x 24 one without). decode_camera_raw runs LibRaw in a forked child, so libFuzzer's coverage
-// guidance sees lucent's side (the answer's parsing, the checks below), not LibRaw's parser: this
-// target holds the guarantee users get, that no bytes crash lucent, rather than fuzzing LibRaw.
+// 24 x 24 one without), and tests/imaging/data/libraw_0.20_abort.dng (LibRaw 0.20 aborts on it).
+// decode_camera_raw runs LibRaw in a forked child, so libFuzzer's coverage guidance sees lucent's
+// side (the answer's parsing, the checks below), not LibRaw's parser: this target holds the
+// guarantee users get, that no bytes crash lucent, rather than fuzzing LibRaw.
 #include <cstddef>
 #include <cstdint>
 #include <string_view>

@@ -302,6 +302,9 @@ bool write_all(int fd, const std::string& bytes) {
 }
 
 [[noreturn]] void run_child(int fd, std::string_view bytes, const std::string& name) {
+  // A crash is the child's to die of: handlers the process installed (a sanitizer's, libFuzzer's)
+  // would report it as lucent's own. The parent turns the signal into the error line.
+  for (int sig : {SIGABRT, SIGSEGV, SIGBUS, SIGFPE, SIGILL}) ::signal(sig, SIG_DFL);
   // LibRaw's own prints (and a fortified abort's message) stay out of lucent's output.
   const int null = ::open("/dev/null", O_WRONLY);
   if (null >= 0) ::dup2(null, STDERR_FILENO), ::dup2(null, STDOUT_FILENO);
@@ -365,7 +368,10 @@ RawImage decode_camera_raw(std::string_view bytes, const std::string& name) {
                 std::to_string(WTERMSIG(status)) + "); it is damaged or crafted, or LibRaw " +
                 "cannot read it");
   }
-  if (answer.empty()) throw Error(name + ": the RAW decoder (LibRaw) gave no answer");
+  if (answer.empty()) {
+    throw Error(name + ": the RAW decoder (LibRaw) gave no answer (exit status " +
+                std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")");
+  }
   if (answer[0] == '\1') throw Error(answer.substr(1));
   return deserialise(answer, name);
 }
