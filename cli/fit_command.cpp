@@ -6,14 +6,15 @@
 
 #include "batch.h"
 #include "commands.h"
-#include "oblique_table.h"
-#include "validators.h"
-#include "lucent/materials/json_file.h"
-#include "lucent/materials/transport_table.h"
 #include "lucent/fit/fit.h"
 #include "lucent/fit/fit_plot.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
+#include "lucent/materials/json_file.h"
+#include "lucent/materials/transport_table.h"
+#include "oblique_table.h"
+#include "progress.h"
+#include "validators.h"
 
 namespace lucent::cli {
 namespace {
@@ -31,8 +32,9 @@ struct FitArguments {
   double ior = 0;
   double g = 0;
   std::string table, oblique_table, batch, shard;
-  bool quiet = false;    // batch rows: no per-row summary on stdout
-  bool row_ior = false;  // a batch row gave ior
+  bool quiet = false;        // batch rows: no per-row summary on stdout
+  bool no_progress = false;  // -q: no progress line on stderr (batch rows never show one)
+  bool row_ior = false;      // a batch row gave ior
   std::uint64_t oblique_photons = 1'000'000;
   bool fit_ior = false, relative = false, json = false, allow_unconverged = false;
   bool plot_log_r = false;  // --plot-log-r
@@ -107,7 +109,8 @@ materials::Material run(const FitArguments& a) {
   for (const std::string& input : a.inputs) {
     data.push_back(fit::load_profile_data(input));
     if (!data.back().eta && !options.ior && !options.fit_ior) {
-      throw Error("--ior: required with " + input + ", which carries no index (no ior= or eta= "
+      throw Error("--ior: required with " + input +
+                  ", which carries no index (no ior= or eta= "
                   "in its comment lines)");
     }
   }
@@ -119,7 +122,10 @@ materials::Material run(const FitArguments& a) {
   const std::optional<materials::TransportTable> oblique =
       oblique_table_for(data, options, a.oblique_table, a.oblique_photons, a.json);
   if (oblique) options.oblique_table = &*oblique;
+  StageProgress progress("fit", a.quiet || a.no_progress);
+  options.progress = [&](const std::string& stage, double done) { progress.stage(stage, done); };
   const fit::FitResult result = fit::fit_profiles(data, options);
+  progress.finish();
   std::string name = a.name;
   if (name.empty()) name = std::filesystem::path(a.output).stem().string();
   const materials::Material material = fit::fitted_material(result, data, options, name);
@@ -138,7 +144,8 @@ materials::Material run(const FitArguments& a) {
 
   const fit::ModelFit& f = result.chosen;
   if (a.quiet) {
-    for (const std::string& w : result.warnings) warn("lucent fit: " + a.output + ": warning: " + w);
+    for (const std::string& w : result.warnings)
+      warn("lucent fit: " + a.output + ": warning: " + w);
     return material;
   }
   if (a.json) {
@@ -161,7 +168,8 @@ materials::Material run(const FitArguments& a) {
               << ch.reduced_chi2 << "\n";
   }
   if (!result.g_09.empty()) {
-    std::cout << "  assumed g = " << result.g << "; at g = " << result.g_other << " the answer would be:";
+    std::cout << "  assumed g = " << result.g << "; at g = " << result.g_other
+              << " the answer would be:";
     for (int c = 0; c < 3; ++c) {
       if (f.channels[c].samples == 0) continue;
       std::cout << " " << names[c] << " sigma_a " << result.g_09[c][0] << ", sigma_s' "
@@ -181,12 +189,16 @@ materials::Material run(const FitArguments& a) {
 // fit` with the row's options over the command line's; a row that fails is recorded, not fatal.
 // -o is the summary (JSON); the exit status is 1 when any row failed.
 void run_batch(const FitArguments& a) {
-  if (!a.inputs.empty()) throw Error("--batch: give the profiles in the manifest, not as arguments");
+  if (!a.inputs.empty())
+    throw Error("--batch: give the profiles in the manifest, not as arguments");
   check_output_file(a.output, ".json", "-o");
   const auto [shard, shards] = a.shard.empty() ? std::pair{0, 1} : parse_shard(a.shard, "--shard");
   const std::vector<BatchRow> rows = read_batch_manifest(a.batch);
   std::vector<BatchOutcome> outcomes;
   int failed = 0;
+  std::uint64_t mine = 0;
+  for (const BatchRow& row : rows) mine += int(row.index % std::size_t(shards)) == shard;
+  ProgressLine progress("fit --batch", "rows", a.no_progress);
   for (const BatchRow& row : rows) {
     if (int(row.index % std::size_t(shards)) != shard) continue;
     BatchOutcome o;
@@ -227,14 +239,18 @@ void run_batch(const FitArguments& a) {
       ++failed;
     }
     outcomes.push_back(std::move(o));
+    progress.update(outcomes.size(), mine);
   }
+  progress.finish();
   const nlohmann::json summary =
       batch_summary(a.batch, rows.size(), outcomes,
                     shards > 1 ? std::to_string(shard) + "/" + std::to_string(shards) : "");
   check_finite_json(summary, a.output);
   write_file_atomically(a.output, summary.dump(2) + "\n");
   std::cout << "fitted " << outcomes.size() - std::size_t(failed) << " of " << outcomes.size()
-            << " rows" << (shards > 1 ? " (shard " + a.shard + " of " + std::to_string(rows.size()) + ")" : std::string())
+            << " rows"
+            << (shards > 1 ? " (shard " + a.shard + " of " + std::to_string(rows.size()) + ")"
+                           : std::string())
             << "; summary " << a.output << '\n';
   // The rows that were fitted and the summary are kept (a job array reruns the failed rows from
   // it); the exit status still says that some failed.
@@ -269,25 +285,28 @@ void register_fit_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--table", args->table,
                   "transport table for the tabulated model (default: the shipped one)");
-  cmd->add_option("--oblique-table", args->oblique_table,
-                  "oblique transport table (lucent tabulate --incidence-deg) for 2D captures at "
-                  "oblique incidence (default: the shipped one when it holds the capture's eta, "
-                  "g and incidence, else one built now and kept in ~/.cache/lucent; none: the directional "
-                  "dipole corrected by the radial table, fast and approximate)");
+  cmd->add_option(
+      "--oblique-table", args->oblique_table,
+      "oblique transport table (lucent tabulate --incidence-deg) for 2D captures at "
+      "oblique incidence (default: the shipped one when it holds the capture's eta, "
+      "g and incidence, else one built now and kept in ~/.cache/lucent; none: the directional "
+      "dipole corrected by the radial table, fast and approximate)");
   cmd->add_option("--oblique-photons", args->oblique_photons,
                   "photons of an oblique table built for this fit (about 50 s per million on "
                   "2 cores)")
       ->check(CLI::Range(std::uint64_t(10'000), std::uint64_t(1'000'000'000)))
       ->capture_default_str();
-  args->exclude_option = cmd->add_option(
-      "--exclude-radius-mm", args->exclude_radius_mm,
-      "leave out samples closer to the entry point than this, mm, in every channel (default: "
-      "per channel; tabulated: two pixels or 0.1 mean free path, dipoles: one transport mean "
-      "free path)")
-      ->check(number_in(0, 1e6, "mm"));
-  args->ior_option = cmd->add_option("--ior", args->ior,
-                  "relative index of refraction of the sample (required with CSV)")
-      ->check(number_in(0, 4, "(relative index of refraction)", true));
+  args->exclude_option = cmd->add_option("--exclude-radius-mm", args->exclude_radius_mm,
+                                         "leave out samples closer to the entry point than this, "
+                                         "mm, in every channel (default: "
+                                         "per channel; tabulated: two pixels or 0.1 mean free "
+                                         "path, dipoles: one transport mean "
+                                         "free path)")
+                             ->check(number_in(0, 1e6, "mm"));
+  args->ior_option =
+      cmd->add_option("--ior", args->ior,
+                      "relative index of refraction of the sample (required with CSV)")
+          ->check(number_in(0, 4, "(relative index of refraction)", true));
   cmd->add_flag("--fit-ior", args->fit_ior, "fit the index too (one for all channels)");
   cmd->add_flag("--relative", args->relative,
                 "fit a global scale (automatic when the profile says it is relative)");
@@ -306,6 +325,7 @@ void register_fit_command(CLI::App& app) {
   cmd->add_flag("--allow-unconverged", args->allow_unconverged,
                 "write the best values even when the solver did not converge");
   cmd->add_flag("--json", args->json, "print the report as JSON on stdout");
+  cmd->add_flag("-q,--quiet", args->no_progress, "no progress line on standard error");
   cmd->add_option("--batch", args->batch,
                   "fit every row of this manifest (CSV: input, output, and optionally ior, model, "
                   "g, name per row; paths from the manifest's folder); -o is then the summary "

@@ -134,8 +134,7 @@ int run_fit_bench(const FitBenchOptions& options, std::ostream& log) {
           }
           err_a /= n, err_s /= n, rms /= n;
           const double t = median(times);
-          csv << bc.name << ',' << model_name << ','
-              << quality_names[q] << ','
+          csv << bc.name << ',' << model_name << ',' << quality_names[q] << ','
               << (model == FitModel::kDipole && analytic ? "analytic" : "automatic") << ',' << t
               << ',' << result.chosen.samples << ',' << err_a << ',' << err_s << ',' << rms << '\n';
           points.push_back(
@@ -191,7 +190,9 @@ int run_fit_bench(const FitBenchOptions& options, std::ostream& log) {
   figure.panels = {panel};
   figure.footer = {
       "error: mean over channels of |fitted / truth - 1| for σ_a and σ_s', averaged; "
-      "model-made captures have an exact truth for their model, the Monte Carlo one has none"};
+      "a model-made capture is exact for its own model only; the Monte Carlo capture's truth is "
+      "transport, "
+      "to which the tabulated model is exact"};
   figure.width = 1100, figure.height = 700;
   imaging::write_plot(options.out_dir / "fit_tradeoff.png", figure);
   return settings;

@@ -4,6 +4,9 @@
 
 #include <cmath>
 #include <numbers>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/directional_dipole.h"
@@ -104,6 +107,26 @@ TEST(Fit, AutoFitsTheTabulatedModelAndJudgesTheDipolesAgainstIt) {
     EXPECT_NEAR(d.sd_sys_sigma_a, std::abs(d.sigma_a - r.chosen.channels[c].sigma_a), 1e-15);
     EXPECT_GE(d.sd_sigma_a, d.sd_stat_sigma_a);
     EXPECT_NEAR(d.sd_sigma_a, std::hypot(d.sd_stat_sigma_a, d.sd_sys_sigma_a), 1e-15);
+  }
+}
+
+TEST(Fit, ProgressNamesEveryStageOfADefaultFitInOrder) {
+  const materials::Material m = materials::load_material("potato");
+  FitOptions o;
+  o.allow_unconverged = true;  // the dipole's own profile: see the test above
+  std::vector<std::pair<std::string, double>> stages;
+  o.progress = [&](const std::string& stage, double done) { stages.emplace_back(stage, done); };
+  fit_profiles({model_profile(m, FitModel::kDipole)}, o);
+  const std::vector<std::string> expected{
+      "fitting the standard dipole", "fitting the tabulated model",
+      "fitting the directional dipole", "the table's systematic (bootstrap and accuracy refits)",
+      "the adequacy of the dipoles and the g systematic"};
+  ASSERT_EQ(stages.size(), expected.size());
+  for (std::size_t i = 0; i < stages.size(); ++i) {
+    EXPECT_EQ(stages[i].first, expected[i]);
+    EXPECT_GE(stages[i].second, 0.0);
+    EXPECT_LT(stages[i].second, 1.0);
+    if (i > 0) EXPECT_GT(stages[i].second, stages[i - 1].second) << stages[i].first;
   }
 }
 

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -62,6 +63,9 @@ struct FitOptions {
   /// Start values per channel {sigma_a, sigma_s'} in mm^-1 instead of the data's (far-field slope
   /// and total reflectance); for tests and for users who know better.
   std::optional<std::array<std::array<double, 2>, 3>> start;
+  /// Told which stage starts and the share of the work done before it (for a progress line);
+  /// optional. The shares are those measured on an oblique capture, where a fit takes seconds.
+  std::function<void(const std::string& stage, double done)> progress;
 };
 
 /// The knobs a Quality sets.
@@ -95,7 +99,7 @@ struct ChannelFit {
   double exclude_radius_mm = 0, range_end_mm = 0;
   /// The usable range in diffuse mean free paths 1 / sigma_tr (the fit's sigma_tr).
   double range_diffusion_lengths = 0;
-  double correlation = 0;                         ///< between sigma_a and sigma_s'
+  double correlation = 0;  ///< between sigma_a and sigma_s'
   double start_sigma_a = 0, start_sigma_s_reduced = 0;
   int samples = 0;          ///< residuals used
   double residual_rms = 0;  ///< in standard errors
@@ -138,11 +142,11 @@ struct ModelAdequacy {
 
 struct FitResult {
   ModelFit chosen;
-  std::vector<ModelFit> candidates;  ///< every model fitted (auto: accurate first)
-  std::string reason;                ///< why this model
-  double exclude_radius_mm = 0;      ///< the smallest of the channels' exclusion radii
-  std::vector<std::string> notes;     ///< assumptions worth saying (assumed errors, ...)
-  std::vector<std::string> warnings;  ///< results to distrust (short range, parameters at bounds)
+  std::vector<ModelFit> candidates;     ///< every model fitted (auto: accurate first)
+  std::string reason;                   ///< why this model
+  double exclude_radius_mm = 0;         ///< the smallest of the channels' exclusion radii
+  std::vector<std::string> notes;       ///< assumptions worth saying (assumed errors, ...)
+  std::vector<std::string> warnings;    ///< results to distrust (short range, parameters at bounds)
   std::vector<ModelAdequacy> adequacy;  ///< cheaper models against the chosen one
   std::string adequate_model;           ///< the cheapest adequate one ("" when none)
   double g = 0;                         ///< the g the tabulated model assumed
