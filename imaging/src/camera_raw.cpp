@@ -3,7 +3,9 @@
 #include <fcntl.h>
 #include <libraw/libraw.h>
 #include <poll.h>
+#include <pthread.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -14,6 +16,7 @@
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <mutex>
 #include <set>
 
 #include "lucent/materials/error.h"
@@ -24,6 +27,7 @@ namespace {
 
 // As for the other readers: at most 16384 x 16384 pixels out (a RAW sensor twice that).
 constexpr long long kMaxSensorPixels = 4ll << 28;
+constexpr int kMaxImageSide = 16384;
 constexpr std::size_t kMaxRawFileBytes = std::size_t(1) << 30;
 
 std::string lower_extension(const std::filesystem::path& path) {
@@ -148,6 +152,9 @@ RawImage read_linear(LibRaw& raw, const std::string& name) {
   const int samples = rd.color3_image ? 3 : 4;
   const std::uint16_t* data = rd.color3_image ? &rd.color3_image[0][0] : &rd.color4_image[0][0];
   const int white = int(std::min<unsigned>(color.maximum, 65535));
+  if (s.width > kMaxImageSide || s.height > kMaxImageSide) {  // one pixel per photosite here
+    throw Error(name + ": the linear DNG is larger than 16384 x 16384 pixels");
+  }
   RawImage image(s.width, s.height, white);
   for (int c = 0; c < 3; ++c) {
     image.black[c] = black_at(color, c, 0, 0);
@@ -272,7 +279,13 @@ RawImage deserialise(const std::string& bytes, const std::string& name) {
   };
   std::int32_t header[3];
   take(header, sizeof header);
-  if (header[0] <= 0 || header[1] <= 0 || header[2] <= 0) throw broken();
+  // Checked before anything is allocated: the child is the process that may have gone wrong.
+  if (header[0] <= 0 || header[1] <= 0 || header[0] > kMaxImageSide || header[1] > kMaxImageSide ||
+      header[2] <= 0 || header[2] > 65535) {
+    throw broken();
+  }
+  const std::size_t pixels_bytes = std::size_t(header[0]) * std::size_t(header[1]) * 3 * 2;
+  if (bytes.size() < at + pixels_bytes) throw broken();
   RawImage image(header[0], header[1], header[2]);
   take(image.black.data(), sizeof(double) * 3);
   double exposure, iso;
@@ -301,7 +314,15 @@ bool write_all(int fd, const std::string& bytes) {
   return true;
 }
 
-[[noreturn]] void run_child(int fd, std::string_view bytes, const std::string& name) {
+[[noreturn]] void run_child(int fd, std::string_view bytes, const std::string& name, pid_t parent) {
+  // The CLI blocks SIGINT/SIGTERM/SIGHUP in every thread for its signal thread, which the child
+  // does not have: unblocked, so that they end a child that hangs; and the child dies with the
+  // parent (a Ctrl-C of lucent must not leave LibRaw spinning).
+  sigset_t none;
+  sigemptyset(&none);
+  ::pthread_sigmask(SIG_SETMASK, &none, nullptr);
+  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (::getppid() != parent) _exit(4);
   // A crash is the child's to die of: handlers the process installed (a sanitizer's, libFuzzer's)
   // would report it as lucent's own. The parent turns the signal into the error line.
   for (int sig : {SIGABRT, SIGSEGV, SIGBUS, SIGFPE, SIGILL}) ::signal(sig, SIG_DFL);
@@ -311,8 +332,10 @@ bool write_all(int fd, const std::string& bytes) {
   std::string answer;
   try {
     answer = serialise(decode_in_this_process(bytes, name));
-  } catch (const std::exception& e) {
+  } catch (const Error& e) {
     answer = std::string(1, '\1') + e.what();  // status 1: lucent's error line follows
+  } catch (const std::exception& e) {
+    answer = std::string(1, '\1') + name + ": the RAW decoder failed: " + e.what();
   }
   _exit(write_all(fd, answer) ? 0 : 3);
 }
@@ -320,49 +343,77 @@ bool write_all(int fd, const std::string& bytes) {
 }  // namespace
 
 RawImage decode_camera_raw(std::string_view bytes, const std::string& name) {
+  // The child owns the pipe's write end alone: a fork by another thread between pipe2 and the
+  // parent's close would keep a copy open, and this read would wait for that child instead.
+  static std::mutex fork_mutex;
+  std::unique_lock fork_lock(fork_mutex);
   int fds[2];
-  if (::pipe2(fds, O_CLOEXEC) != 0) throw Error(name + ": cannot start the RAW decoder (pipe)");
+  if (::pipe2(fds, O_CLOEXEC) != 0) {
+    throw Error(name + ": cannot start the RAW decoder (pipe: " + std::strerror(errno) + ")");
+  }
   std::fflush(nullptr);
+  const pid_t parent = ::getpid();
   const pid_t child = ::fork();
   if (child < 0) {
+    const int error = errno;
     ::close(fds[0]), ::close(fds[1]);
-    throw Error(name + ": cannot start the RAW decoder (fork)");
+    throw Error(name + ": cannot start the RAW decoder (fork: " + std::strerror(error) + ")");
   }
   if (child == 0) {
     ::close(fds[0]);
-    run_child(fds[1], bytes, name);
+    run_child(fds[1], bytes, name, parent);
   }
   ::close(fds[1]);
+  fork_lock.unlock();
+  // Whatever happens here (a timeout, bad_alloc while reading), the pipe is closed and the child
+  // killed if it still runs, and reaped.
+  struct ChildGuard {
+    int fd;
+    pid_t pid;
+    bool reaped = false;
+    int status = 0;
+    int wait() {
+      if (fd >= 0) ::close(fd), fd = -1;
+      while (!reaped && ::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+      }
+      reaped = true;
+      return status;
+    }
+    ~ChildGuard() {
+      if (!reaped) ::kill(pid, SIGKILL);
+      wait();
+    }
+  } guard{fds[0], child};
+
   std::string answer;
   char buffer[1 << 16];
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::seconds(kChildTimeoutSeconds);
   bool timed_out = false;
   for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-        deadline - std::chrono::steady_clock::now());
-    if (left.count() <= 0) {
+    const long long left = std::chrono::duration_cast<std::chrono::milliseconds>(
+                               deadline - std::chrono::steady_clock::now())
+                               .count();
+    if (left <= 0) {
       timed_out = true;
       break;
     }
-    pollfd p{fds[0], POLLIN, 0};
-    const int ready = ::poll(&p, 1, int(std::min<long long>(left.count(), 1000)));
-    if (ready < 0 && errno == EINTR) continue;
-    if (ready == 0) continue;
-    const ssize_t n = ::read(fds[0], buffer, sizeof buffer);
+    pollfd p{guard.fd, POLLIN, 0};
+    const int ready = ::poll(&p, 1, int(std::min<long long>(left, 1 << 30)));
+    if (ready < 0 && errno != EINTR) break;  // the answer so far decides (cut short: an error)
+    if (ready <= 0) continue;                // EINTR, or the deadline: the loop's test decides
+    const ssize_t n = ::read(guard.fd, buffer, sizeof buffer);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) break;
     answer.append(buffer, std::size_t(n));
   }
-  ::close(fds[0]);
-  if (timed_out) ::kill(child, SIGKILL);
-  int status = 0;
-  while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
-  }
   if (timed_out) {
+    ::kill(child, SIGKILL);
+    guard.wait();
     throw Error(name + ": the RAW decoder (LibRaw) did not finish in " +
                 std::to_string(kChildTimeoutSeconds) + " s; the file is damaged or crafted");
   }
+  const int status = guard.wait();
   if (WIFSIGNALED(status)) {
     throw Error(name + ": the RAW decoder (LibRaw) crashed on this file (signal " +
                 std::to_string(WTERMSIG(status)) + "); it is damaged or crafted, or LibRaw " +

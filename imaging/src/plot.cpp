@@ -13,6 +13,7 @@
 
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
+#include "lucent/materials/xml_text.h"
 #include "plot_layout.h"
 
 namespace lucent::imaging {
@@ -414,21 +415,6 @@ PlotLayout render(const PlotFigure& f, const std::string& device, const std::str
   return layout;
 }
 
-std::string xml_escaped(const std::string& s) {
-  std::string out;
-  for (char ch : s) {
-    if (ch == '&')
-      out += "&amp;";
-    else if (ch == '<')
-      out += "&lt;";
-    else if (ch == '>')
-      out += "&gt;";
-    else
-      out += ch;
-  }
-  return out;
-}
-
 // cairo's SVG draws text as glyph outlines: a <title> and <desc> keep the words searchable.
 void add_svg_text(const fs::path& file, const PlotFigure& f) {
   std::ifstream in(file, std::ios::binary);
@@ -447,8 +433,11 @@ void add_svg_text(const fs::path& file, const PlotFigure& f) {
   }
   for (const std::string& line : f.footer) desc += line + "\n";
   svg.insert(end + 1,
-             "\n<title>" + xml_escaped(title) + "</title>\n<desc>" + xml_escaped(desc) + "</desc>");
-  std::ofstream(file, std::ios::binary | std::ios::trunc) << svg;
+             "\n<title>" + xml_escape(title) + "</title>\n<desc>" + xml_escape(desc) + "</desc>");
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  out << svg;
+  out.flush();
+  if (!out) throw Error("the SVG's title and description could not be written (disk full?)");
 }
 
 }  // namespace
@@ -499,7 +488,13 @@ PlotLayout write_plot(const fs::path& path, const PlotFigure& figure) {
     throw Error(where + e.what());
   }
   if (!plplot_abort_message.empty()) throw Error(where + "PLplot: " + plplot_abort_message);
-  if (format == PlotFormat::kSvg) add_svg_text(out.temporary(), figure);
+  if (format == PlotFormat::kSvg) {
+    try {
+      add_svg_text(out.temporary(), figure);
+    } catch (const Error& e) {
+      throw Error(where + e.what());
+    }
+  }
   std::error_code ec;
   if (!(fs::file_size(out.temporary(), ec) > 0) || ec)
     throw Error(where + "the device wrote nothing");

@@ -10,6 +10,7 @@
 #include "lucent/materials/albedo.h"
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/error.h"
+#include "lucent/materials/xml_text.h"
 
 namespace lucent::materials {
 namespace {
@@ -20,27 +21,15 @@ std::string num(double v) {
   std::snprintf(buffer, sizeof buffer, "%.9g", v);
   return buffer;
 }
-double reread(double v) { return std::stod(num(v)); }
+double reread(double v) {
+  return std::stod(num(v));
+}
 
 std::string triple(const Rgb& v, const char* separator) {
   return num(v[0]) + separator + num(v[1]) + separator + num(v[2]);
 }
 
 // XML attribute and element text: names may hold anything a material file's name does.
-std::string xml_escape(const std::string& s) {
-  std::string out;
-  for (char ch : s) {
-    switch (ch) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += ch;
-    }
-  }
-  return out;
-}
 // A MaterialX node name: letters, digits and underscores.
 std::string mtlx_name(const std::string& s) {
   std::string out;
@@ -137,8 +126,9 @@ ExportResult to_pbrt(const Material& m, double mm_per_unit) {
     << "    \"float scale\" [ " << num(mm_per_unit) << " ]\n";
   r.text = s.str();
   add_g_loss(c, r);
-  r.losses.push_back("pbrt's subsurface material renders with its own tabulated photon beam "
-                     "diffusion BSSRDF, not lucent's model (the medium form is exact transport)");
+  r.losses.push_back(
+      "pbrt's subsurface material renders with its own tabulated photon beam "
+      "diffusion BSSRDF, not lucent's model (the medium form is exact transport)");
   for (int i = 0; i < 3; ++i) {
     r.sigma_a_back[i] = reread(c.sigma_a[i]);
     r.sigma_s_reduced_back[i] = reread(c.sigma_s[i]) * (1 - reread(c.g_mean));
@@ -166,7 +156,8 @@ ExportResult to_mitsuba(const Material& m, double mm_per_unit) {
     << "\" target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform>\n"
     << "    <film type=\"hdrfilm\"><integer name=\"width\" value=\"256\"/>"
     << "<integer name=\"height\" value=\"256\"/></film>\n"
-    << "    <sampler type=\"independent\"><integer name=\"sample_count\" value=\"256\"/></sampler>\n"
+    << "    <sampler type=\"independent\"><integer name=\"sample_count\" "
+       "value=\"256\"/></sampler>\n"
     << "  </sensor>\n"
     << "  <emitter type=\"constant\"><rgb name=\"radiance\" value=\"1\"/></emitter>\n"
     << "  <bsdf type=\"dielectric\" id=\"" << id << "_interface\">\n"
@@ -197,7 +188,8 @@ ExportResult to_mitsuba(const Material& m, double mm_per_unit) {
 
 ExportResult to_materialx(const Material& m, double mm_per_unit, bool openpbr) {
   const Channels c = channels_of(m);
-  const Appearance a = appearance_of(m, openpbr ? ExportTarget::kOpenPbr : ExportTarget::kMaterialX);
+  const Appearance a =
+      appearance_of(m, openpbr ? ExportTarget::kOpenPbr : ExportTarget::kMaterialX);
   ExportResult r;
   const double longest = std::max({a.mfp_mm[0], a.mfp_mm[1], a.mfp_mm[2]});
   Rgb relative{};
@@ -271,9 +263,10 @@ ExportResult to_gltf(const Material& m, double mm_per_unit) {
        {{"version", "2.0"},
         {"generator", "lucent export"},
         {"extras",
-         {{"note", "multiscatterColor and the diffuse transmission colour = the standard "
-                   "dipole's total diffuse reflectance; attenuation = extinction sigma_t "
-                   "(lucent's sigma_a + sigma_s); thicknessFactor is a placeholder 1 cm"},
+         {{"note",
+           "multiscatterColor and the diffuse transmission colour = the standard "
+           "dipole's total diffuse reflectance; attenuation = extinction sigma_t "
+           "(lucent's sigma_a + sigma_s); thicknessFactor is a placeholder 1 cm"},
           {"lucent_material", m.name}}}}},
       {"extensionsUsed",
        {"KHR_materials_ior", "KHR_materials_volume", "KHR_materials_diffuse_transmission",
@@ -298,8 +291,9 @@ ExportResult to_gltf(const Material& m, double mm_per_unit) {
              {"scatterAnisotropy", c.g_mean}}}}}}}}};
   r.text = doc.dump(2) + "\n";
   add_g_loss(c, r);
-  r.losses.push_back("KHR_materials_volume_scatter is a draft: viewers without it show the "
-                     "diffuse transmission and the attenuation only");
+  r.losses.push_back(
+      "KHR_materials_volume_scatter is a draft: viewers without it show the "
+      "diffuse transmission and the attenuation only");
   r.losses.push_back("thicknessFactor is the mesh's business: 0.01 m is written");
   // Round trip: sigma_t from the attenuation, alpha' from the multiscatter colour by lucent's
   // inversion of the dipole (sigma_t' = sigma_a + sigma_s (1 - g)).
@@ -329,22 +323,31 @@ ExportTarget parse_export_target(const std::string& name) {
 
 const char* to_string(ExportTarget t) {
   switch (t) {
-    case ExportTarget::kPbrt: return "pbrt";
-    case ExportTarget::kMitsuba: return "mitsuba";
-    case ExportTarget::kMaterialX: return "materialx";
-    case ExportTarget::kOpenPbr: return "openpbr";
-    case ExportTarget::kGltf: return "gltf";
+    case ExportTarget::kPbrt:
+      return "pbrt";
+    case ExportTarget::kMitsuba:
+      return "mitsuba";
+    case ExportTarget::kMaterialX:
+      return "materialx";
+    case ExportTarget::kOpenPbr:
+      return "openpbr";
+    case ExportTarget::kGltf:
+      return "gltf";
   }
   return "?";
 }
 
 const char* export_extension(ExportTarget t) {
   switch (t) {
-    case ExportTarget::kPbrt: return ".pbrt";
-    case ExportTarget::kMitsuba: return ".xml";
+    case ExportTarget::kPbrt:
+      return ".pbrt";
+    case ExportTarget::kMitsuba:
+      return ".xml";
     case ExportTarget::kMaterialX:
-    case ExportTarget::kOpenPbr: return ".mtlx";
-    case ExportTarget::kGltf: return ".gltf";
+    case ExportTarget::kOpenPbr:
+      return ".mtlx";
+    case ExportTarget::kGltf:
+      return ".gltf";
   }
   return "";
 }
@@ -358,11 +361,16 @@ double millimetres_per_unit(const std::string& unit) {
 
 ExportResult export_material(const Material& m, ExportTarget t, double mm_per_unit) {
   switch (t) {
-    case ExportTarget::kPbrt: return to_pbrt(m, mm_per_unit);
-    case ExportTarget::kMitsuba: return to_mitsuba(m, mm_per_unit);
-    case ExportTarget::kMaterialX: return to_materialx(m, mm_per_unit, false);
-    case ExportTarget::kOpenPbr: return to_materialx(m, mm_per_unit, true);
-    case ExportTarget::kGltf: return to_gltf(m, mm_per_unit);
+    case ExportTarget::kPbrt:
+      return to_pbrt(m, mm_per_unit);
+    case ExportTarget::kMitsuba:
+      return to_mitsuba(m, mm_per_unit);
+    case ExportTarget::kMaterialX:
+      return to_materialx(m, mm_per_unit, false);
+    case ExportTarget::kOpenPbr:
+      return to_materialx(m, mm_per_unit, true);
+    case ExportTarget::kGltf:
+      return to_gltf(m, mm_per_unit);
   }
   throw Error("export: unknown target");
 }
