@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -12,6 +13,7 @@
 #include "lucent/imaging/image_io.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
+#include "lucent/materials/json_file.h"
 #include "lucent/render/image_compare.h"
 #include "lucent/render/tone_map.h"
 
@@ -24,6 +26,7 @@ struct CompareArguments {
   std::string difference;
   float scale = 10;
   bool signed_difference = false;
+  bool fit_scale = false;
 };
 
 void run_compare(const CompareArguments& args) {
@@ -57,8 +60,12 @@ void run_compare(const CompareArguments& args) {
     tone.exposure = args.scale;
     render::write_render_image(args.difference, diff, tone);
   }
+  std::optional<render::ScaledComparison> scaled;
+  if (args.fit_scale) {
+    scaled = render::compare_scaled(image, reference, render::nonzero_mask(reference));
+  }
   if (args.json) {
-    const nlohmann::json doc = {{"format", "lucent-image-difference"},
+    nlohmann::json doc = {{"format", "lucent-image-difference"},
                                 {"version", 1},
                                 {"image", args.image},
                                 {"reference", args.reference},
@@ -66,9 +73,17 @@ void run_compare(const CompareArguments& args) {
                                 {"relative_rmse", d.relative_rmse},
                                 {"mean_ratio", d.mean_ratio},
                                 {"reference_mean", d.reference_mean}};
+    if (scaled) {
+      doc["scaled"] = {{"scale", scaled->scale},
+                       {"channel_scale", scaled->channel_scale},
+                       {"correlation", scaled->correlation},
+                       {"relative_rmse", scaled->relative_rmse}};
+    }
+    check_finite_json(doc, "compare --json");
     std::printf("%s\n", doc.dump(2).c_str());
   } else {
     std::printf("compare: %s\n", d.to_string().c_str());
+    if (scaled) std::printf("compare (scaled): %s\n", scaled->to_string().c_str());
   }
 }
 
@@ -92,6 +107,10 @@ void register_compare_command(CLI::App& app) {
                 "--difference: red where the image is brighter, blue where darker");
   cmd->add_option("--scale", args->scale, "--difference: multiplier before the tone curve")
       ->capture_default_str();
+  cmd->add_flag("--fit-scale", args->fit_scale,
+                "also the least-squares scale of the image to the reference, the relative RMSE "
+                "after it, and the correlation (for renders right only up to a scale: --technique "
+                "sh)");
   cmd->callback([args] { run_compare(*args); });
 }
 

@@ -21,6 +21,7 @@
 #include "lucent/render/reference_renderer.h"
 #include "lucent/render/render_settings.h"
 #include "lucent/render/scene.h"
+#include "lucent/render/sh_renderer.h"
 #include "lucent/render/tone_map.h"
 #include "scene_options.h"
 
@@ -63,7 +64,7 @@ void run_render(RenderArguments& render_args) {
   const bool show_progress = ::isatty(STDERR_FILENO) != 0;
   ImageRgb image;
   RenderStats stats;
-  if (args.technique == "reference" && !render_args.snapshots.empty()) {
+  if (args.technique != "maps" && !render_args.snapshots.empty()) {
     throw Error("--snapshots: frame snapshots are of the radiance maps (--technique maps)");
   }
   if (args.technique == "reference") {
@@ -72,6 +73,8 @@ void run_render(RenderArguments& render_args) {
     if (show_progress) std::fprintf(stderr, "\n");
     image = std::move(result.image);
     stats = std::move(result.stats);
+  } else if (args.technique == "sh") {
+    image = render_sh(scene, args.sh, &stats);
   } else {
     RadianceMapOptions options;
     options.max_blur_level = args.max_blur;
@@ -110,6 +113,7 @@ void run_render(RenderArguments& render_args) {
                   {"environment", args.env},
                   {"view", args.view}};
   if (args.technique == "maps") doc["settings"] = args.settings.to_string();
+  if (args.technique == "sh") doc["settings"] = args.sh.to_string();
   if (!render_args.stats.empty()) {
     check_finite_json(doc, render_args.stats);
     write_file_atomically(render_args.stats, doc.dump(2) + "\n");
@@ -126,7 +130,9 @@ void run_render(RenderArguments& render_args) {
   } else {
     std::printf("render: wrote %s (%dx%d, %s, %s on %s, %s%s) in %.1f s\n", render_args.output.c_str(),
               scene.camera.width, scene.camera.height,
-              args.technique == "maps" ? "radiance maps" : "CPU reference",
+              args.technique == "maps" ? "radiance maps"
+              : args.technique == "sh" ? "SH fast translucency"
+                                       : "CPU reference",
               materials::to_string(args.settings.model).c_str(), scene.mesh.name.c_str(),
               png ? "exposure " : "linear",
               png ? (std::to_string(tone.exposure) + (args.auto_exposure ? " (auto)" : "")).c_str()

@@ -83,8 +83,9 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
                   "FILE[:L]: lat-long environment map (.exr or .hdr), shown as background and lit "
                   "by L importance-sampled directional lights (default L = 16)");
   cmd->add_option("--technique", args->technique,
-                  "maps (real-time radiance maps, OpenGL) or reference (CPU, slow, exact up to "
-                  "sampling noise)")
+                  "maps (real-time radiance maps, OpenGL), sh (spherical-harmonics fast "
+                  "translucency, OpenGL, seed 000: not physically based) or reference (CPU, slow, "
+                  "exact up to sampling noise)")
       ->capture_default_str();
   cmd->add_option("--model", args->model,
                   "tabulated (exact to Monte Carlo transport), ddipole (directional dipole) or "
@@ -163,6 +164,24 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
                   "strata, a new one every frame: converges to all M after M/N frames) or nearest "
                   "(seed 003: the N nearest, every frame; misses the far profile)")
       ->capture_default_str();
+  cmd->add_option("--shadow-map", args->sh.shadow_map_size,
+                  "sh: the primary light's shadow map (and depth peel), texels per side")
+      ->capture_default_str();
+  cmd->add_option("--cube-map", args->sh.cube_map_size,
+                  "sh: texels per face of the external cube map of the lit object")
+      ->capture_default_str();
+  cmd->add_option("--depth-blur", args->sh.depth_blur_sigma_texels,
+                  "sh: sigma of the Gaussian blur of the light's depth map, shadow-map texels (0: "
+                  "none)")
+      ->capture_default_str();
+  cmd->add_option("--sh-fresnel", args->sh_fresnel,
+                  "sh: F_t in the cube map: exact (unpolarised Fresnel) or schlick (the seed's)")
+      ->capture_default_str();
+  cmd->add_option("--sh-attenuation", args->sh_attenuation,
+                  "sh: the attenuation in the thickness: seed (eq. 12 as printed, guarded), "
+                  "normalised (eq. 12 scaled to R_tot at d = 0) or slab (eq. 12 integrated over "
+                  "the plane, scaled to R_tot at d = 0)")
+      ->capture_default_str();
   cmd->add_option("--max-blur", args->max_blur,
                   "maps: mip blur levels at the first frame, fewer as frames accumulate (0 = none; "
                   "-1: none with the profile disc, 2 with the exponential one)")
@@ -190,9 +209,15 @@ SceneSetup build_scene(SceneArguments& args) {
     throw Error("--view: expected AZ in [-3600, 3600] degrees, EL in [-90, 90] degrees and DIST "
                 "in (0, 1e4] bounding radii, got '" + args.view + "'");
   }
-  if (args.technique != "maps" && args.technique != "reference") {
-    throw Error("--technique: expected maps or reference, got '" + args.technique + "'");
+  if (args.technique != "maps" && args.technique != "sh" && args.technique != "reference") {
+    throw Error("--technique: expected maps, sh or reference, got '" + args.technique + "'");
   }
+  if (args.sh_fresnel != "exact" && args.sh_fresnel != "schlick") {
+    throw Error("--sh-fresnel: expected exact or schlick, got '" + args.sh_fresnel + "'");
+  }
+  args.sh.schlick = args.sh_fresnel == "schlick";
+  args.sh.attenuation = render::parse_sh_attenuation(args.sh_attenuation);
+  args.sh.validate();
   if (!(args.object_size_mm > 0) || !std::isfinite(args.object_size_mm)) {
     throw Error("--object-size-mm: must be positive");
   }

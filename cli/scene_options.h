@@ -11,6 +11,7 @@
 #include "lucent/render/reference_renderer.h"
 #include "lucent/render/render_settings.h"
 #include "lucent/render/scene.h"
+#include "lucent/render/sh_renderer.h"
 
 namespace lucent::cli {
 
@@ -36,6 +37,9 @@ struct SceneArguments {
   std::vector<std::string> default_rig;  ///< set by build_scene: the lights used when none given
   render::RenderSettings settings;
   render::ReferenceOptions reference;
+  render::ShOptions sh;            ///< --technique sh: shadow map, cube map, depth blur, Fresnel
+  std::string sh_fresnel = "exact";  ///< exact | schlick
+  std::string sh_attenuation = "slab";  ///< seed | normalised | slab
 };
 
 /// Adds the shared options to `cmd`; `size_help` says what --size is (image or window).

@@ -58,4 +58,55 @@ ImageDifference compare_images(const ImageRgb& image, const ImageRgb& reference,
   return d;
 }
 
+std::string ScaledComparison::to_string() const {
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "best scale %.5g (R %.5g G %.5g B %.5g), correlation %.4f, relative RMSE after the "
+                "scale %.4f over %zu pixels",
+                scale, channel_scale[0], channel_scale[1], channel_scale[2], correlation,
+                relative_rmse, pixels);
+  return text;
+}
+
+ScaledComparison compare_scaled(const ImageRgb& image, const ImageRgb& reference,
+                                const std::vector<std::uint8_t>& mask) {
+  compare_images(image, reference, mask);  // the size and mask checks
+  ScaledComparison r;
+  std::array<double, 3> ab{}, aa{};
+  double sa = 0, sb = 0, n = 0;
+  for (std::size_t p = 0; p < mask.size(); ++p) {
+    if (!mask[p]) continue;
+    ++r.pixels;
+    for (int c = 0; c < 3; ++c) {
+      const double a = image.data[3 * p + std::size_t(c)], b = reference.data[3 * p + std::size_t(c)];
+      ab[std::size_t(c)] += a * b;
+      aa[std::size_t(c)] += a * a;
+      sa += a;
+      sb += b;
+      n += 1;
+    }
+  }
+  const double sum_aa = aa[0] + aa[1] + aa[2];
+  if (!(sum_aa > 0)) throw Error("compare: the image is black where the reference shows the object");
+  r.scale = (ab[0] + ab[1] + ab[2]) / sum_aa;
+  for (int c = 0; c < 3; ++c) {
+    r.channel_scale[std::size_t(c)] = aa[std::size_t(c)] > 0 ? ab[std::size_t(c)] / aa[std::size_t(c)] : 0;
+  }
+  const double ma = sa / n, mb = sb / n;
+  double cov = 0, va = 0, vb = 0, squared = 0;
+  for (std::size_t p = 0; p < mask.size(); ++p) {
+    if (!mask[p]) continue;
+    for (int c = 0; c < 3; ++c) {
+      const double a = image.data[3 * p + std::size_t(c)], b = reference.data[3 * p + std::size_t(c)];
+      cov += (a - ma) * (b - mb);
+      va += (a - ma) * (a - ma);
+      vb += (b - mb) * (b - mb);
+      squared += (r.scale * a - b) * (r.scale * a - b);
+    }
+  }
+  r.correlation = va > 0 && vb > 0 ? cov / std::sqrt(va * vb) : 0;
+  r.relative_rmse = mb > 0 ? std::sqrt(squared / n) / mb : INFINITY;
+  return r;
+}
+
 }  // namespace lucent::render

@@ -10,8 +10,11 @@ lucent_add_test(radiance_maps_test
 lucent_add_test(slab_truth_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/slab_truth_test.cpp
   LIBS lucent::render lucent::materials OpenGL::OpenGL)
+lucent_add_test(sh_renderer_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/sh_renderer_test.cpp
+  LIBS lucent::render lucent::materials OpenGL::OpenGL)
 # White-box: both include headers from render/src (gl_program.h, gl_bssrdf.h,
 # radiance_maps_sampling.h).
-foreach(t glsl_twin_test radiance_maps_test)
+foreach(t glsl_twin_test radiance_maps_test sh_renderer_test)
   target_include_directories(${t} PRIVATE ${PROJECT_SOURCE_DIR}/render/src)
 endforeach()

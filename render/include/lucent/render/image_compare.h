@@ -27,4 +27,21 @@ std::vector<std::uint8_t> nonzero_mask(const ImageRgb& reference);
 ImageDifference compare_images(const ImageRgb& image, const ImageRgb& reference,
                                const std::vector<std::uint8_t>& mask);
 
+/// A render that is right only up to a scale (`--technique sh`, not physically based) against a
+/// reference: the least-squares scale s minimising sum (s image - reference)^2 over the mask's
+/// pixels and channels, the relative RMSE of s image (as compare_images), and Pearson's
+/// correlation of the image's and the reference's values, which no scale changes.
+struct ScaledComparison {
+  std::size_t pixels = 0;
+  double scale = 0;
+  std::array<double, 3> channel_scale{};  ///< the least-squares scale of each channel alone
+  double correlation = 0;
+  double relative_rmse = 0;  ///< of scale * image
+  std::string to_string() const;
+};
+
+/// Throws lucent::Error as compare_images, and when the image is zero on the whole mask.
+ScaledComparison compare_scaled(const ImageRgb& image, const ImageRgb& reference,
+                                const std::vector<std::uint8_t>& mask);
+
 }  // namespace lucent::render

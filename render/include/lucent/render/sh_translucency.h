@@ -379,6 +379,25 @@ T attenuation(T d_mm, T sigma_tr, T sigma_t_reduced) {
   return (s + T(1)) * exp(-s) / (sigma_t_reduced * d2 * d_eff);
 }
 
+/// Eq. 12's kernel integrated over a plane at distance d (a named extension): a slab of thickness
+/// d lit uniformly on its far side sends a point on its near side
+///   integral over the plane of (sigma_tr r + 1) e^(-sigma_tr r) / (sigma_t' r^3) dA,
+///   r^2 = d^2 + rho^2,  = 2 pi e^(-sigma_tr d) / (sigma_t' d),
+/// as d/dr (-e^(-s r) / r) = (s r + 1) e^(-s r) / r^2. Eq. 12 treats the whole lit side as one
+/// point at distance d and falls as d^-3; lit surface spread across the light's footprint falls as
+/// d^-1 (this form), which is what a back-lit object shows near its thin parts. The same d_eff
+/// guard as attenuation(); mm^-1.
+template <typename T>
+T attenuation_slab(T d_mm, T sigma_tr, T sigma_t_reduced) {
+  using std::exp;
+  using std::sqrt;
+  if (!(sigma_t_reduced > T(0))) return T(0);
+  const T d = d_mm > T(0) ? d_mm : T(0);
+  const T z_r = T(1) / sigma_t_reduced;
+  const T d_eff = sqrt(d * d + z_r * z_r);
+  return T(2) * T(std::numbers::pi) * exp(-sigma_tr * d_eff) / (sigma_t_reduced * d_eff);
+}
+
 /// attenuation() with sigma_tr and sigma_t' of one channel's derived coefficients.
 template <typename T>
 T attenuation(T d_mm, const materials::DiffusionCoefficients<T>& c) {
