@@ -52,11 +52,13 @@ add_custom_command(
 target_sources(lucent_render PRIVATE
   "${LUCENT_GL_DIR}/src/gl_bssrdf.cpp"
   "${LUCENT_GL_DIR}/src/gl_context.cpp"
+  "${LUCENT_GL_DIR}/src/gl_frame.cpp"
   "${LUCENT_GL_DIR}/src/gl_program.cpp"
   "${LUCENT_GL_DIR}/src/radiance_maps.cpp"
   "${LUCENT_GL_DIR}/src/radiance_maps_frame.cpp"
   "${LUCENT_GL_DIR}/src/radiance_maps_sampling.cpp"
   "${LUCENT_GL_DIR}/src/sh_renderer.cpp"
+  "${LUCENT_GL_DIR}/src/sh_renderer_frame.cpp"
   "${LUCENT_SHADER_CPP}")
 # gl_shader_sources.cpp includes gl_shader_sources.h from render/src.
 target_include_directories(lucent_render PRIVATE "${LUCENT_GL_DIR}/src")

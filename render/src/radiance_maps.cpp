@@ -124,30 +124,8 @@ void RadianceMapRenderer::Impl::build(const Scene& s, const RenderSettings& rs,
 }
 
 void RadianceMapRenderer::Impl::upload_mesh() {
-  const Mesh& m = scene.mesh;
-  mesh_vao = gl::create_vertex_array();
+  mesh = gl::upload_mesh(scene.mesh);
   empty_vao = gl::create_vertex_array();
-  positions = gl::create_buffer();
-  normals = gl::create_buffer();
-  indices = gl::create_buffer();
-  // Positions and normals stay writable: a deforming mesh replaces them every frame (set_geometry).
-  glNamedBufferStorage(positions.id(), GLsizeiptr(m.positions.size() * sizeof(Vec3f)),
-                       m.positions.data(), GL_DYNAMIC_STORAGE_BIT);
-  glNamedBufferStorage(normals.id(), GLsizeiptr(m.normals.size() * sizeof(Vec3f)), m.normals.data(),
-                       GL_DYNAMIC_STORAGE_BIT);
-  glNamedBufferStorage(indices.id(), GLsizeiptr(m.triangles.size() * sizeof(m.triangles[0])),
-                       m.triangles.data(), 0);
-  static_assert(sizeof(Vec3f) == 3 * sizeof(float));
-  index_count = GLsizei(m.triangles.size() * 3);
-  const GLuint vao = mesh_vao.id();
-  glVertexArrayVertexBuffer(vao, 0, positions.id(), 0, sizeof(Vec3f));
-  glVertexArrayVertexBuffer(vao, 1, normals.id(), 0, sizeof(Vec3f));
-  glVertexArrayElementBuffer(vao, indices.id());
-  for (GLuint a = 0; a < 2; ++a) {
-    glEnableVertexArrayAttrib(vao, a);
-    glVertexArrayAttribFormat(vao, a, 3, GL_FLOAT, GL_FALSE, 0);
-    glVertexArrayAttribBinding(vao, a, a);
-  }
 }
 
 void RadianceMapRenderer::Impl::build_programs() {
@@ -287,12 +265,7 @@ void RadianceMapRenderer::Impl::build_final() {
 
   has_environment = false;
   if (scene.environment) {
-    const EnvironmentMap map = load_environment(*scene.environment);
-    environment = gl::create_texture(GL_TEXTURE_2D);
-    glTextureStorage2D(environment.id(), 1, GL_RGB32F, map.image.width, map.image.height);
-    // Row 0 (the top, theta = 0) goes to t = 0, so v = theta / pi reads it directly.
-    glTextureSubImage2D(environment.id(), 0, 0, 0, map.image.width, map.image.height, GL_RGB,
-                        GL_FLOAT, map.image.data.data());
+    environment = gl::upload_environment(*scene.environment);
     has_environment = true;
   }
 }
@@ -425,8 +398,7 @@ void RadianceMapRenderer::Impl::render_light_map() {
   glDisable(GL_BLEND);
   light_map_program.use();
   glBindBufferBase(GL_UNIFORM_BUFFER, kLightMatricesBinding, light_matrices.id());
-  glBindVertexArray(mesh_vao.id());
-  glDrawElementsInstanced(GL_TRIANGLES, index_count, GL_UNSIGNED_INT, nullptr, L);
+  mesh.draw_instanced(L);
 }
 
 void RadianceMapRenderer::Impl::render_radiance_depth() {
@@ -444,8 +416,7 @@ void RadianceMapRenderer::Impl::render_radiance_depth() {
   radiance_program.use();
   glProgramUniform1i(radiance_program.id(), radiance_program.location("u_depth_only"), 1);
   glBindBufferBase(GL_UNIFORM_BUFFER, kLayerCamerasBinding, layer_cameras.id());
-  glBindVertexArray(mesh_vao.id());
-  glDrawElementsInstanced(GL_TRIANGLES, index_count, GL_UNSIGNED_INT, nullptr, K);
+  mesh.draw_instanced(K);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glProgramUniform1i(radiance_program.id(), radiance_program.location("u_depth_only"), 0);
 }
@@ -483,8 +454,7 @@ void RadianceMapRenderer::Impl::render_radiance() {
     glBindTextureUnit(kUnitTabulated, tabulated_rows.id());
     glBindSampler(kUnitTabulated, nearest.id());
   }
-  glBindVertexArray(mesh_vao.id());
-  glDrawElementsInstanced(GL_TRIANGLES, index_count, GL_UNSIGNED_INT, nullptr, K);
+  mesh.draw_instanced(K);
   glDepthMask(GL_TRUE);
   current = target;
 }
@@ -510,19 +480,8 @@ void RadianceMapRenderer::Impl::render_final() {
   glClearNamedFramebufferfv(final_fbo.id(), GL_DEPTH, 0, &one);
   const detail::Mat4f view_proj = detail::camera_view_proj(scene.camera, centre, radius_mm);
 
-  glDisable(GL_DEPTH_TEST);
-  background_program.use();
-  const detail::Mat4f inverse = view_proj.inverse();
-  glUniformMatrix4fv(background_program.location("u_inverse_view_proj"), 1, GL_FALSE,
-                     inverse.data());
-  glUniform1i(background_program.location("u_has_environment"), has_environment ? 1 : 0);
-  glUniform3fv(background_program.location("u_backdrop"), 1, scene.backdrop.data());
-  if (has_environment) {
-    glBindTextureUnit(kUnitEnvironment, environment.id());
-    glBindSampler(kUnitEnvironment, environment_sampler.id());
-  }
-  glBindVertexArray(empty_vao.id());
-  glDrawArrays(GL_TRIANGLES, 0, 3);
+  gl::draw_background(background_program, view_proj, has_environment ? environment.id() : 0,
+                      environment_sampler.id(), kUnitEnvironment, scene.backdrop, empty_vao.id());
 
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
@@ -550,15 +509,11 @@ void RadianceMapRenderer::Impl::render_final() {
   glBindSampler(kUnitRadiance, mip_nearest.id());
   glBindTextureUnit(kUnitRadianceDepth, radiance_depth.id());
   glBindSampler(kUnitRadianceDepth, shadow.id());
-  glBindVertexArray(mesh_vao.id());
-  glDrawElements(GL_TRIANGLES, index_count, GL_UNSIGNED_INT, nullptr);
+  mesh.draw();
 }
 
 std::vector<float> RadianceMapRenderer::Impl::read_rgba() const {
-  std::vector<float> rgba(std::size_t(final_width) * final_height * 4);
-  glGetTextureImage(final_color.id(), 0, GL_RGBA, GL_FLOAT, GLsizei(rgba.size() * sizeof(float)),
-                    rgba.data());
-  return rgba;
+  return gl::read_rgba(final_color.id(), final_width, final_height);
 }
 
 void RadianceMapRenderer::Impl::record_convergence() {

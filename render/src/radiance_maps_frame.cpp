@@ -29,19 +29,9 @@ void RadianceMapRenderer::set_lights(const std::vector<Light>& lights) {
 void RadianceMapRenderer::set_geometry(const std::vector<Vec3f>& positions,
                                        const std::vector<Vec3f>& normals) {
   Impl& m = *impl_;
-  if (positions.size() != m.scene.mesh.positions.size() ||
-      normals.size() != m.scene.mesh.positions.size()) {
-    throw Error("radiance maps: a deformed mesh must keep its " +
-                std::to_string(m.scene.mesh.positions.size()) + " vertices (got " +
-                std::to_string(positions.size()) + " positions, " + std::to_string(normals.size()) +
-                " normals)");
-  }
+  gl::update_mesh(m.mesh, m.scene.mesh, positions, normals, "radiance maps");
   m.scene.mesh.positions = positions;
   m.scene.mesh.normals = normals;
-  glNamedBufferSubData(m.positions.id(), 0, GLsizeiptr(positions.size() * sizeof(Vec3f)),
-                       positions.data());
-  glNamedBufferSubData(m.normals.id(), 0, GLsizeiptr(normals.size() * sizeof(Vec3f)),
-                       normals.data());
   // Nothing is precomputed per mesh beyond what depends on its bounds: the layer and light cameras
   // are refitted, the radiance maps' depth pre-pass redone, and accumulation restarts.
   m.centre = m.scene.mesh.centre();
@@ -109,43 +99,18 @@ bool RadianceMapRenderer::converged() const {
 
 ImageRgb RadianceMapRenderer::read_image() const {
   const Impl& m = *impl_;
-  const std::vector<float> rgba = m.read_rgba();
-  ImageRgb image(m.final_width, m.final_height);
-  for (int y = 0; y < m.final_height; ++y) {
-    const int row = m.final_height - 1 - y;  // GL rows go up from the bottom
-    for (int x = 0; x < m.final_width; ++x) {
-      for (int c = 0; c < 3; ++c) {
-        image.at(x, y, c) = rgba[(std::size_t(row) * m.final_width + x) * 4 + std::size_t(c)];
-      }
-    }
-  }
-  return image;
+  return gl::image_from_rgba(m.read_rgba(), m.final_width, m.final_height);
 }
 
 std::vector<std::uint8_t> RadianceMapRenderer::read_mask() const {
   const Impl& m = *impl_;
-  const std::vector<float> rgba = m.read_rgba();
-  std::vector<std::uint8_t> mask(std::size_t(m.final_width) * m.final_height);
-  for (int y = 0; y < m.final_height; ++y) {
-    const int row = m.final_height - 1 - y;
-    for (int x = 0; x < m.final_width; ++x) {
-      mask[std::size_t(y) * m.final_width + x] =
-          rgba[(std::size_t(row) * m.final_width + x) * 4 + 3] > 0 ? 1 : 0;
-    }
-  }
-  return mask;
+  return gl::mask_from_rgba(m.read_rgba(), m.final_width, m.final_height);
 }
 
 void RadianceMapRenderer::present(float exposure, int width, int height) const {
   const Impl& m = *impl_;
-  glViewport(0, 0, width, height);
-  glDisable(GL_DEPTH_TEST);
-  m.present_program.use();
-  glUniform1f(m.present_program.location("u_exposure"), exposure);
-  glBindTextureUnit(0, m.final_color.id());
-  glBindSampler(0, m.linear_clamp.id());
-  glBindVertexArray(m.empty_vao.id());
-  glDrawArrays(GL_TRIANGLES, 0, 3);
+  gl::draw_present(m.present_program, m.final_color.id(), m.linear_clamp.id(), m.empty_vao.id(),
+                   exposure, width, height);
 }
 
 const RadianceMapStats& RadianceMapRenderer::stats() const {

@@ -11,6 +11,7 @@
 
 #include "gl_api.h"
 #include "gl_bssrdf.h"
+#include "gl_frame.h"
 #include "gl_program.h"
 #include "lucent/materials/error.h"
 #include "lucent/render/environment.h"
@@ -64,9 +65,8 @@ struct RadianceMapRenderer::Impl {
   int K = 0, L = 0;
   int final_width = 0, final_height = 0;
 
-  gl::VertexArray mesh_vao, empty_vao;
-  gl::Buffer positions, normals, indices;
-  GLsizei index_count = 0;
+  gl::MeshBuffers mesh;
+  gl::VertexArray empty_vao;
 
   gl::Program light_map_program, radiance_program, blur_program, final_program, background_program,
       present_program;
