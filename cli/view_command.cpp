@@ -47,6 +47,7 @@ void run_view(ViewArguments& args) {
   options.view = {setup.azimuth_deg, setup.elevation_deg, setup.distance_radii};
   options.object_size_mm = args.scene.object_size_mm;
   options.technique = args.scene.technique;
+  options.sh = args.scene.sh;
   options.deform_amplitude = args.deform;
   options.script = args.script;
   options.hide_panel = args.hide_panel;
@@ -77,9 +78,10 @@ void register_view_command(CLI::App& app) {
       "Preview a material on a mesh in a window (GLFW; needs an X display, e.g. xvfb-run -a). "
       "Left drag orbits, the wheel zooms, right drag moves a light, S saves a screenshot "
       "(lucent_view_NNN.png; the image without the panel), R restarts, H hides the panel, D shows "
-      "the difference against the last CPU reference of the same view, Esc quits. The panel "
+      "the difference of the current technique (maps, or sh after its best scale) against the last "
+      "CPU reference of the same view, Esc quits. The panel "
       "(scaled to the window) switches the material (library or file, reloaded when the file "
-      "changes), technique and model, edits the material (per channel mean free path and albedo, "
+      "changes), technique (maps, sh, reference) and model, edits the material (per channel mean free path and albedo, "
       "eta, g), and has sliders for N, M, q, K, W_s, W_l, T, exposure, object size and the "
       "deformer.");
   // The reference in the window runs pass after pass at half the window's resolution: fewer

@@ -4,7 +4,8 @@
 //   p = its exit from the bounding box          (the seed's fix of the "shift" problem);
 //   B_c = q^T M_c q, q = p's cube direction     (eq. 10, M_c built from the GPU projection);
 //   d = distance to the primary light - the blurred first depth there, the thickness along the
-//       light's ray; 0 scattering where x_o lies beyond the second depth (the seed's Figure 9);
+//       light's ray; 0 scattering where x_o lies beyond the second depth (the seed's Figure 9),
+//       the test percentage-closer filtered over 3 x 3 texels (an extension: no terminator speckle);
 //   L_ss,c = (1 / pi) F_t(eta, n_o . w_o) a_c(d) B_c   (eq. 10 with eq. 12's attenuation a_c and
 //       the d_eff guard), or (u_slab) eq. 12 integrated over the plane at d; each channel times
 //       u_attenuation_scale (ShAttenuation: R_tot / a_c(0), so that d = 0 shows (1 / pi) F_t
@@ -13,7 +14,7 @@
 // sees directly has d = 0 and takes a_c(0) B_c, the same scattering term at its thinnest; the
 // surface reflection of every light is the specular lobe (specular.glsl, the primary light
 // shadowed, the others not), and an environment map adds F_r L_env(reflect(-w_o, n_o)).
-// u_output 1 writes (d, beyond second depth ? 1 : 0, lit by the primary ? 1 : 0) and 2 writes x_o
+// u_output 1 writes (d, the fraction beyond the second depth, lit by the primary ? 1 : 0), 2 writes x_o
 // (mm): the tests read them.
 #include "math.glsl"
 #include "fresnel.glsl"
@@ -48,6 +49,27 @@ float fetch(sampler2D map, vec2 uv) {
   return texelFetch(map, min(ivec2(uv * vec2(size)), size - 1), 0).r;
 }
 
+// Bilinear over the texels that hold a surface (weights renormalised): the thickness follows the
+// surface between texel centres instead of stepping, which at grazing light stretches each texel
+// over many pixels along the terminator.
+float fetch_bilinear_surface(sampler2D map, vec2 uv) {
+  ivec2 size = textureSize(map, 0);
+  vec2 p = uv * vec2(size) - 0.5;
+  ivec2 p0 = ivec2(floor(p));
+  vec2 f = p - vec2(p0);
+  float sum = 0.0, weight = 0.0;
+  for (int j = 0; j <= 1; ++j)
+    for (int i = 0; i <= 1; ++i) {
+      float v = texelFetch(map, clamp(p0 + ivec2(i, j), ivec2(0), size - 1), 0).r;
+      float w = (i == 1 ? f.x : 1.0 - f.x) * (j == 1 ? f.y : 1.0 - f.y);
+      if (v < kShNoSurface * 0.5) {
+        sum += w * v;
+        weight += w;
+      }
+    }
+  return weight > 0.0 ? sum / weight : kShNoSurface;
+}
+
 void main() {
   vec3 x_o = f_position;
   vec3 n_o = normalize(f_normal);
@@ -56,22 +78,32 @@ void main() {
 
   // Thickness along the primary light's ray.
   float d = 0.0;
-  bool beyond = false, lit = false;
+  float beyond_fraction = 0.0;
+  bool lit = false;
   vec2 uv = sh_shadow_uv(x_o);
   vec3 w_p, E_p;
   sh_light_at(u_primary, x_o, w_p, E_p);
   if (uv.x >= 0.0) {
     float t = sh_distance(x_o);
-    float blurred = fetch(u_blurred_depth, uv);
+    float blurred = fetch_bilinear_surface(u_blurred_depth, uv);
     float first = fetch(u_first_depth, uv);
-    float second = fetch(u_second_depth, uv);
     float bias = sh_shadow_bias(n_o, w_p);
     if (blurred < kShNoSurface * 0.5) d = max(t - blurred, 0.0);
-    beyond = second < kShNoSurface * 0.5 && t > second + bias;
-    lit = first >= kShNoSurface * 0.5 || t <= first + bias;
+    // The beyond-the-second-depth test, percentage-closer filtered over 3 x 3 texels: at grazing
+    // light the second depth changes by many biases from one texel to the next, and a single
+    // comparison flickers into speckle along the terminator.
+    ivec2 size = textureSize(u_second_depth, 0);
+    ivec2 centre = min(ivec2(uv * vec2(size)), size - 1);
+    for (int j = -1; j <= 1; ++j)
+      for (int i = -1; i <= 1; ++i) {
+        float s = texelFetch(u_second_depth, clamp(centre + ivec2(i, j), ivec2(0), size - 1), 0).r;
+        beyond_fraction += (s < kShNoSurface * 0.5 && t > s + bias) ? 1.0 / 9.0 : 0.0;
+      }
+    // A surface facing away from the light is never lit by it, whatever the biased test says.
+    lit = dot(n_o, w_p) > 0.0 && (first >= kShNoSurface * 0.5 || t <= first + bias);
   }
   if (u_output == 1) {
-    out_color = vec4(d, beyond ? 1.0 : 0.0, lit ? 1.0 : 0.0, 1.0);
+    out_color = vec4(d, beyond_fraction, lit ? 1.0 : 0.0, 1.0);
     return;
   }
   if (u_output == 2) {
@@ -82,7 +114,7 @@ void main() {
   vec3 L = vec3(0.0);
   float cos_o = dot(n_o, w_o);
   float F_r = fresnel_reflectance(cos_o, u_eta);
-  if (!beyond) {
+  if (beyond_fraction < 1.0) {
     vec3 r = refract(-w_o, n_o, 1.0 / u_eta);
     if (dot(r, r) > 0.0) {
       vec3 q = sh_box_lookup_direction(u_box_min, u_box_max,
@@ -91,7 +123,7 @@ void main() {
       for (int k = 0; k < 27; ++k) e[k] = coefficients[k];
       for (int c = 0; c < 3; ++c) {
         float B = max(sh_irradiance(sh_irradiance_matrix(e, 9 * c), q), 0.0);
-        L[c] = (1.0 - F_r) / kPi * u_attenuation_scale[c] *
+        L[c] = (1.0 - beyond_fraction) * (1.0 - F_r) / kPi * u_attenuation_scale[c] *
                (u_slab ? sh_attenuation_slab(d, u_sigma_tr[c], u_sigma_t_reduced[c])
                        : sh_attenuation(d, u_sigma_tr[c], u_sigma_t_reduced[c])) * B;
       }

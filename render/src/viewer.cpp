@@ -81,7 +81,8 @@ int Viewer::run() {
     // Frames as fast as they come while the maps accumulate or the mesh moves; otherwise wake for
     // input, a finished reference pass (the worker needs the CPU more than the window does) and,
     // now and then, to watch the material file.
-    const bool accumulating = technique_ == "maps" && maps_ && (deformer_ || !maps_->converged());
+    const bool accumulating = (technique_ == "maps" && maps_ && (deformer_ || !maps_->converged())) ||
+                              (technique_ == "sh" && deformer_);
     if (accumulating) {
       glfwPollEvents();
     } else {
@@ -119,9 +120,9 @@ void Viewer::frame() {
   run_script_step();
   handle_keys();
   handle_mouse();
-  if (deformer_ && technique_ == "maps" && maps_) {
+  if (deformer_ && technique_ != "reference") {
     deformer_->apply(now, scene_.mesh);
-    maps_->set_geometry(scene_.mesh.positions, scene_.mesh.normals);
+    apply_geometry();
     ++restarts_;
   }
 
@@ -147,6 +148,8 @@ void Viewer::frame() {
       } else {
         maps_->present(settings_.exposure, width_, height_);
       }
+    } else if (technique_ == "sh") {
+      draw_sh();
     } else {
       draw_reference();
     }
@@ -168,7 +171,9 @@ void Viewer::run_script_step() {
   const double now = glfwGetTime();
   if (now < sleep_until_) return;
   if (settling_) {
-    const bool done = technique_ == "maps" ? (maps_ && maps_->converged()) : reference_passes_ > 0;
+    const bool done = technique_ == "maps" ? (maps_ && maps_->converged())
+                      : technique_ == "sh" ? (sh_ && sh_->stats().frames > 0)
+                                           : reference_passes_ > 0;
     if (!done && now < settle_deadline_) return;
     if (!done) std::fprintf(stderr, "view: settle: still not done after %g s\n", kSettleTimeout);
     settling_ = false;
@@ -383,10 +388,8 @@ void Viewer::set_object_size(double mm) {
   }
   if (deformer_) deformer_.emplace(rest_mesh_, deform_amplitude_);
   scene_.mesh = rest_mesh_;
-  if (maps_) {
-    maps_->set_geometry(scene_.mesh.positions, scene_.mesh.normals);
-    maps_->set_lights(scene_.lights);
-  }
+  apply_geometry();
+  if (maps_) maps_->set_lights(scene_.lights);
   view_changed();
   scene_changed();
 }
@@ -398,119 +401,14 @@ void Viewer::set_deform(float amplitude) {
   } else if (deformer_) {
     deformer_.reset();
     scene_.mesh = rest_mesh_;
-    if (maps_) maps_->set_geometry(scene_.mesh.positions, scene_.mesh.normals);
+    apply_geometry();
     scene_changed();
   }
 }
 
-void Viewer::set_technique(const std::string& technique) {
-  if (technique != "maps" && technique != "reference") {
-    throw Error("technique: expected maps or reference, got '" + technique + "'");
-  }
-  technique_ = technique;
-  // Same scene, another technique: the cached reference stays valid for the difference view.
-  const std::uint64_t version = scene_version_;
-  scene_changed();
-  scene_version_ = version;
-}
-
-void Viewer::draw_reference() {
-  ImageRgb mean;
-  int passes = 0;
-  if (reference_->take(mean, passes, reference_error_)) {
-    cached_reference_ = mean;
-    reference_version_ = scene_version_;
-    if (auto_exposure_) {
-      settings_.exposure = pending_.exposure = auto_exposure(mean);
-      auto_exposure_ = false;
-    }
-    reference_passes_ = passes;
-  }
-  glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
-  glClear(GL_COLOR_BUFFER_BIT);
-  if (reference_passes_ > 0 && !cached_reference_.data.empty()) {
-    blit(cached_reference_, settings_.exposure);
-  }
-}
-
-void Viewer::draw_difference() {
-  glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
-  glClear(GL_COLOR_BUFFER_BIT);
-  if (reference_version_ != scene_version_ || cached_reference_.data.empty()) {
-    difference_text_ =
-        "no reference for this view: switch to the CPU reference, let it run a "
-        "pass, come back";
-    maps_->present(settings_.exposure, width_, height_);
-    return;
-  }
-  // The maps' image averaged 2 x 2 down to the reference's half resolution.
-  const ImageRgb full = maps_->read_image();
-  const ImageRgb& ref = cached_reference_;
-  ImageRgb small(ref.width, ref.height, 0.0f);
-  const int fx = std::max(1, full.width / ref.width), fy = std::max(1, full.height / ref.height);
-  for (int y = 0; y < ref.height; ++y)
-    for (int x = 0; x < ref.width; ++x)
-      for (int c = 0; c < 3; ++c) {
-        float sum = 0;
-        for (int j = 0; j < fy; ++j)
-          for (int i = 0; i < fx; ++i)
-            sum += full.at(std::min(full.width - 1, x * fx + i),
-                           std::min(full.height - 1, y * fy + j), c);
-        small.at(x, y, c) = sum / float(fx * fy);
-      }
-  const auto mask = nonzero_mask(ref);
-  try {
-    const ImageDifference d = compare_images(small, ref, mask);
-    difference_text_ = d.to_string();
-    if (frames_drawn_ - difference_frame_ >= 30) {
-      std::printf("view: maps (frame %d) against the reference (%d passes): %s\n",
-                  maps_->accumulated_frames(), reference_passes_, difference_text_.c_str());
-      difference_frame_ = frames_drawn_;
-    }
-    ImageRgb diff(ref.width, ref.height, 0.0f);
-    for (std::size_t p = 0; p < mask.size(); ++p)
-      for (int c = 0; c < 3; ++c)
-        diff.data[3 * p + std::size_t(c)] =
-            mask[p] ? float(std::abs(small.data[3 * p + std::size_t(c)] -
-                                     ref.data[3 * p + std::size_t(c)]) /
-                            d.reference_mean)
-                    : 0.0f;
-    blit(diff, 10.0f);  // 10 x the relative difference: white is 10% of the mean
-  } catch (const Error& e) {
-    difference_text_ = e.what();
-  }
-}
-
-void Viewer::blit(const ImageRgb& mean, float exposure) {
-  {
-    // Tone-mapped on the CPU with the same curve as the maps' present(), then blitted.
-    ToneMapOptions tone;
-    tone.exposure = exposure;
-    const imaging::RawImage srgb = tone_map(mean, tone);
-    std::vector<std::uint8_t> rgb(srgb.data.size());
-    const float to_byte = 255.0f / float(srgb.max_value);
-    for (std::size_t i = 0; i < rgb.size(); ++i) {
-      rgb[i] = std::uint8_t(std::lround(float(srgb.data[i]) * to_byte));
-    }
-    if (mean.width != reference_w_ || mean.height != reference_h_) {
-      if (reference_fbo_ != 0) glDeleteFramebuffers(1, &reference_fbo_);
-      if (reference_texture_ != 0) glDeleteTextures(1, &reference_texture_);
-      glCreateTextures(GL_TEXTURE_2D, 1, &reference_texture_);
-      glTextureStorage2D(reference_texture_, 1, GL_RGBA8, mean.width, mean.height);
-      glCreateFramebuffers(1, &reference_fbo_);
-      glNamedFramebufferTexture(reference_fbo_, GL_COLOR_ATTACHMENT0, reference_texture_, 0);
-      reference_w_ = mean.width;
-      reference_h_ = mean.height;
-    }
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glTextureSubImage2D(reference_texture_, 0, 0, 0, mean.width, mean.height, GL_RGB,
-                        GL_UNSIGNED_BYTE, rgb.data());
-  }
-  if (reference_fbo_ != 0) {
-    // Row 0 of the image is the top: flip while blitting.
-    glBlitNamedFramebuffer(reference_fbo_, 0, 0, 0, reference_w_, reference_h_, 0, height_, width_,
-                           0, GL_COLOR_BUFFER_BIT, GL_LINEAR);
-  }
+void Viewer::apply_geometry() {
+  ++geometry_version_;  // sh takes it at its next frame
+  if (maps_) maps_->set_geometry(scene_.mesh.positions, scene_.mesh.normals);
 }
 
 std::filesystem::path Viewer::next_screenshot_path() const {

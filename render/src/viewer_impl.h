@@ -30,6 +30,7 @@
 #include "lucent/materials/material.h"
 #include "lucent/materials/profile_table.h"
 #include "lucent/render/radiance_maps.h"
+#include "lucent/render/sh_renderer.h"
 #include "lucent/render/tone_map.h"
 
 #include "lucent/render/image_compare.h"
@@ -225,6 +226,8 @@ class Viewer {
   void run_script_step();
   void draw_ui();
   void draw_reference();
+  void draw_sh();        // sync the scene into the sh renderer, one frame, present
+  void apply_geometry(); // scene_.mesh changed: the maps (and sh at its next frame) take it
 
   void view_changed();
   void scene_changed();  // lights, material or geometry: restart whatever is accumulating
@@ -236,7 +239,8 @@ class Viewer {
   void set_technique(const std::string& technique);
   void screenshot(const std::filesystem::path& path);
   void blit(const ImageRgb& image, float exposure);  // tone-mapped, stretched to the window
-  void draw_difference();                            // maps against the cached reference
+  void draw_difference();  // the current technique against the cached reference
+  ImageRgb technique_image() const;  // the maps' or sh's last image, window size
   void draw_material_controls();
   void apply_material(const materials::Material& material);
   std::filesystem::path next_screenshot_path() const;
@@ -256,6 +260,9 @@ class Viewer {
   OrbitView view_;
   std::string technique_;
   std::unique_ptr<RadianceMapRenderer> maps_;
+  std::unique_ptr<ShRenderer> sh_;  // made when sh is first chosen; remade on a new window size
+  int sh_width_ = 0, sh_height_ = 0;
+  std::uint64_t geometry_version_ = 0, sh_geometry_version_ = 0;
   std::unique_ptr<ReferenceWorker> reference_;
   FileWatcher watcher_;
   double last_watch_ = 0;

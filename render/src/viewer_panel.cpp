@@ -39,10 +39,12 @@ void Viewer::draw_ui() {
   if (ImGui::Button("load")) load_material(material_path_.data());
 
   // Technique and model.
-  int technique = technique_ == "maps" ? 0 : 1;
+  int technique = technique_ == "maps" ? 0 : technique_ == "sh" ? 1 : 2;
   if (ImGui::RadioButton("radiance maps", &technique, 0)) set_technique("maps");
   ImGui::SameLine();
-  if (ImGui::RadioButton("CPU reference", &technique, 1)) set_technique("reference");
+  if (ImGui::RadioButton("SH fast", &technique, 1)) set_technique("sh");
+  ImGui::SameLine();
+  if (ImGui::RadioButton("CPU reference", &technique, 2)) set_technique("reference");
   int model = settings_.model == DiffusionModel::kDirectionalDipole ? 0
               : settings_.model == DiffusionModel::kDipole          ? 1
                                                                     : 2;
@@ -138,12 +140,23 @@ void Viewer::draw_ui() {
     if (s.uncovered_fraction > 0) {
       ImGui::Text("unseen by every layer: %.1f%% of pixels", 100 * s.uncovered_fraction);
     }
+  } else if (technique_ == "sh" && sh_) {
+    const ShStats& s = sh_->stats();
+    const ShPassTimes& t = s.last_wall;
+    ImGui::Text("frame %d, primary light %d", s.frames, s.primary_light);
+    ImGui::Text("shadow+peel %8.2f ms", t.shadow_ms + t.peel_ms);
+    ImGui::Text("depth blur  %8.2f ms", t.blur_ms);
+    ImGui::Text("cube map    %8.2f ms", t.cube_ms);
+    ImGui::Text("SH project  %8.2f ms", t.project_ms);
+    ImGui::Text("final       %8.2f ms", t.final_ms);
+    ImGui::Text("window frame %7.1f ms", frame_ms_);
+    ImGui::TextDisabled("not physically based: D compares it after a best scale");
   } else {
     ImGui::Text("reference passes %d (%d probes per pixel each)", reference_passes_,
                 options_.reference.pixel_samples);
     if (!reference_error_.empty()) ImGui::TextWrapped("%s", reference_error_.c_str());
   }
-  if (technique_ == "maps") {
+  if (technique_ != "reference") {
     ImGui::Checkbox("difference vs reference (D)", &show_difference_);
     if (show_difference_) ImGui::TextWrapped("%s", difference_text_.c_str());
   }

@@ -1,6 +1,9 @@
 // `lucent view`: the material preview window (GLFW + Dear ImGui, OpenGL 4.5 core). The radiance
 // maps accumulate while nothing changes and restart when something does; the CPU reference can be
-// switched in (progressive passes on worker threads, shown as they finish).
+// switched in (progressive passes on worker threads, shown as they finish), and so can the SH fast
+// translucency (seed 000: every pass every frame, nothing accumulated). The difference view (D)
+// holds the current technique against the cached reference of the same view (sh after its
+// least-squares scale: it is not physically based).
 //
 // Controls: left drag orbits, the wheel zooms, right drag moves the selected light around the
 // object; S saves a screenshot (lucent_view_NNN.png in the working folder), R restarts the
@@ -14,6 +17,7 @@
 #include "lucent/render/reference_renderer.h"
 #include "lucent/render/render_settings.h"
 #include "lucent/render/scene.h"
+#include "lucent/render/sh_renderer.h"
 #include "lucent/render/viewer_controls.h"
 
 namespace lucent::render {
@@ -26,7 +30,8 @@ struct ViewerOptions {
   ReferenceOptions reference;      ///< surface samples per pass, threads and seed for the reference
   OrbitView view;                  ///< --view
   double object_size_mm = 100;     ///< the mesh's bounding-box diagonal as loaded
-  std::string technique = "maps";  ///< maps | reference
+  std::string technique = "maps";  ///< maps | sh | reference
+  ShOptions sh;                    ///< --technique sh: shadow map, cube map, depth blur, Fresnel
   float deform_amplitude = 0;      ///< sine deformer: fraction of the diagonal; 0 = off
   /// Actions, one per frame, separated by ';' (tests and demos drive the window with them):
   ///   orbit DX DY | light DX DY   mouse drags in pixels (left button / right button)
