@@ -303,6 +303,14 @@ Mesh load_mesh(const std::string& name_or_path, double object_size_mm) {
   if (name_or_path == "sphere") {
     mesh = make_icosphere(4);  // 5120 triangles
     exact_normals = true;
+  } else if (name_or_path.rfind("sphere:", 0) == 0) {
+    // sphere:L, an icosphere of 20 * 4^L triangles (L 0..7): a mesh-resolution knob.
+    const std::string level = name_or_path.substr(7);
+    if (level.size() != 1 || level[0] < '0' || level[0] > '7') {
+      throw Error("mesh '" + name_or_path + "': expected sphere:0 .. sphere:7 (20 x 4^L triangles)");
+    }
+    mesh = make_icosphere(level[0] - '0');
+    exact_normals = true;
   } else if (name_or_path == "bunny") {
     mesh = load_bunny();
   } else if (name_or_path.rfind("dragon:", 0) == 0) {

@@ -76,7 +76,8 @@ struct Scene {
 /// Parses `directional:DX,DY,DZ:R,G,B` or `point:X,Y,Z:R,G,B`; throws lucent::Error naming --light.
 Light parse_light(const std::string& text);
 
-/// Built-in meshes and files: "sphere", "bunny", "dragon:1".."dragon:4" (1 finest; from the npm data
+/// Built-in meshes and files: "sphere" (an icosphere of 5120 triangles; "sphere:L" has 20 x 4^L,
+/// L 0..7), "bunny", "dragon:1".."dragon:4" (1 finest; from the npm data
 /// cache, $LUCENT_DATA_CACHE or ~/.cache/lucent), or a path to a PLY or OBJ file (Assimp). The mesh
 /// is centred and scaled so that its bounding-box diagonal is `object_size_mm`. Empty meshes throw;
 /// non-manifold ones load with a warning on stderr.
