@@ -17,6 +17,7 @@
 #include "lucent/materials/json_file.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
+#include "lucent/render/hierarchical_renderer.h"
 #include "lucent/render/radiance_maps.h"
 #include "lucent/render/reference_renderer.h"
 #include "lucent/render/render_settings.h"
@@ -75,6 +76,8 @@ void run_render(RenderArguments& render_args) {
     stats = std::move(result.stats);
   } else if (args.technique == "sh") {
     image = render_sh(scene, args.sh, &stats);
+  } else if (args.technique == "hierarchical") {
+    image = render_hierarchical(scene, args.hbe, &stats);
   } else {
     RadianceMapOptions options;
     options.max_blur_level = args.max_blur;
@@ -114,6 +117,7 @@ void run_render(RenderArguments& render_args) {
                   {"view", args.view}};
   if (args.technique == "maps") doc["settings"] = args.settings.to_string();
   if (args.technique == "sh") doc["settings"] = args.sh.to_string();
+  if (args.technique == "hierarchical") doc["settings"] = args.hbe.to_string();
   if (!render_args.stats.empty()) {
     check_finite_json(doc, render_args.stats);
     write_file_atomically(render_args.stats, doc.dump(2) + "\n");
@@ -131,8 +135,9 @@ void run_render(RenderArguments& render_args) {
     std::printf("render: wrote %s (%dx%d, %s, %s on %s, %s%s) in %.1f s\n", render_args.output.c_str(),
               scene.camera.width, scene.camera.height,
               args.technique == "maps" ? "radiance maps"
-              : args.technique == "sh" ? "SH fast translucency"
-                                       : "CPU reference",
+              : args.technique == "sh"           ? "SH fast translucency"
+              : args.technique == "hierarchical" ? "hierarchical boundary elements"
+                                                 : "CPU reference",
               materials::to_string(args.settings.model).c_str(), scene.mesh.name.c_str(),
               png ? "exposure " : "linear",
               png ? (std::to_string(tone.exposure) + (args.auto_exposure ? " (auto)" : "")).c_str()

@@ -84,8 +84,10 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
                   "by L importance-sampled directional lights (default L = 16)");
   cmd->add_option("--technique", args->technique,
                   "maps (real-time radiance maps, OpenGL), sh (spherical-harmonics fast "
-                  "translucency, OpenGL, seed 000: not physically based) or reference (CPU, slow, "
-                  "exact up to sampling noise)")
+                  "translucency, OpenGL, seed 000: not physically based), hierarchical "
+                  "(boundary elements on a face-cluster hierarchy, seed 004: the standard dipole, "
+                  "solved on the CPU, shaded per vertex on the GPU) or reference (CPU, slow, exact "
+                  "up to sampling noise)")
       ->capture_default_str();
   cmd->add_option("--model", args->model,
                   "tabulated (exact to Monte Carlo transport), ddipole (directional dipole) or "
@@ -182,6 +184,38 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
                   "normalised (eq. 12 scaled to R_tot at d = 0) or slab (eq. 12 integrated over "
                   "the plane, scaled to R_tot at d = 0)")
       ->capture_default_str();
+  cmd->add_option("--hbe-mode", args->hbe_mode,
+                  "hierarchical: render (links kept), incremental (links repaired within "
+                  "--hbe-budget per frame) or on-the-fly (no stored links)")
+      ->capture_default_str();
+  cmd->add_option("--hbe-epsilon1", args->hbe.epsilon_1,
+                  "hierarchical: split the receiver when the emitter's solid angle seen from its "
+                  "children deviates by more than this, sr")
+      ->capture_default_str();
+  cmd->add_option("--hbe-epsilon2", args->hbe.epsilon_2,
+                  "hierarchical: split the emitter when its solid angle exceeds this, sr")
+      ->capture_default_str();
+  cmd->add_option("--hbe-near", args->hbe.near,
+                  "hierarchical: links above this solid angle (sr) use the semi-analytic form "
+                  "factor, the others one midpoint sample")
+      ->capture_default_str();
+  cmd->add_option("--hbe-planarity", args->hbe.min_planarity,
+                  "hierarchical: near emitter clusters less planar than this A'/A are split")
+      ->capture_default_str();
+  cmd->add_option("--hbe-edge-constant", args->hbe.form_factor.edge_constant,
+                  "hierarchical: split edge segments until L/r0 < c and L sigma_tr < c (seed: 0.4)")
+      ->capture_default_str();
+  cmd->add_option("--hbe-rule", args->hbe_rule,
+                  "hierarchical: per segment, midpoint (the seed's eq. 17) or gauss2 (two-point "
+                  "Gauss-Legendre)")
+      ->capture_default_str();
+  cmd->add_option("--hbe-dipole", args->hbe_dipole,
+                  "hierarchical: chord (R_d of the chord distance, lucent's, as the reference) or "
+                  "seed (sources at x_o -/+ z n_o)")
+      ->capture_default_str();
+  cmd->add_option("--hbe-budget", args->hbe.budget,
+                  "hierarchical, incremental: link factors evaluated per frame")
+      ->capture_default_str();
   cmd->add_option("--max-blur", args->max_blur,
                   "maps: mip blur levels at the first frame, fewer as frames accumulate (0 = none; "
                   "-1: none with the profile disc, 2 with the exponential one)")
@@ -209,8 +243,18 @@ SceneSetup build_scene(SceneArguments& args) {
     throw Error("--view: expected AZ in [-3600, 3600] degrees, EL in [-90, 90] degrees and DIST "
                 "in (0, 1e4] bounding radii, got '" + args.view + "'");
   }
-  if (args.technique != "maps" && args.technique != "sh" && args.technique != "reference") {
-    throw Error("--technique: expected maps, sh or reference, got '" + args.technique + "'");
+  if (args.technique != "maps" && args.technique != "sh" && args.technique != "hierarchical" &&
+      args.technique != "reference") {
+    throw Error("--technique: expected maps, sh, hierarchical or reference, got '" +
+                args.technique + "'");
+  }
+  args.hbe.mode = render::hbe::parse_mode(args.hbe_mode);
+  args.hbe.form_factor.rule = render::hbe::parse_segment_rule(args.hbe_rule);
+  args.hbe.form_factor.placement = render::hbe::parse_dipole_placement(args.hbe_dipole);
+  args.hbe.validate();
+  if (args.technique == "hierarchical" && !args.model.empty() && args.model != "dipole") {
+    throw Error("--model: the hierarchical technique integrates the standard dipole (seed 004), "
+                "got '" + args.model + "'; use --model dipole or leave it out");
   }
   if (args.sh_fresnel != "exact" && args.sh_fresnel != "schlick") {
     throw Error("--sh-fresnel: expected exact or schlick, got '" + args.sh_fresnel + "'");
@@ -287,6 +331,7 @@ SceneSetup build_scene(SceneArguments& args) {
   args.settings.model = !args.model.empty()
                             ? materials::parse_diffusion_model(args.model, "--model", true)
                             : materials::preferred_model(scene.material);
+  if (args.technique == "hierarchical") args.settings.model = DiffusionModel::kDipole;
   scene.mesh = load_mesh(args.mesh, args.object_size_mm);
   scene.lights = lights;
   if (env) {

@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "lucent/render/reference_renderer.h"
+#include "lucent/render/hierarchical.h"
 #include "lucent/render/render_settings.h"
 #include "lucent/render/scene.h"
 #include "lucent/render/sh_renderer.h"
@@ -40,6 +41,8 @@ struct SceneArguments {
   render::ShOptions sh;            ///< --technique sh: shadow map, cube map, depth blur, Fresnel
   std::string sh_fresnel = "exact";  ///< exact | schlick
   std::string sh_attenuation = "slab";  ///< seed | normalised | slab
+  render::hbe::Options hbe;        ///< --technique hierarchical: oracle, form factor, mode
+  std::string hbe_mode = "render", hbe_rule = "gauss2", hbe_dipole = "chord";
 };
 
 /// Adds the shared options to `cmd`; `size_help` says what --size is (image or window).

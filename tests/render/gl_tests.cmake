@@ -18,3 +18,6 @@ lucent_add_test(sh_renderer_test
 foreach(t glsl_twin_test radiance_maps_test sh_renderer_test)
   target_include_directories(${t} PRIVATE ${PROJECT_SOURCE_DIR}/render/src)
 endforeach()
+lucent_add_test(hierarchical_renderer_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/hierarchical_renderer_test.cpp
+  LIBS lucent::render lucent::materials OpenGL::OpenGL)

@@ -1,0 +1,54 @@
+// `--technique hierarchical` on OpenGL 4.5: the CPU solve of hierarchical.h each frame (links as
+// its mode keeps them), the per-vertex B uploaded as a vertex attribute, and the fragment shader's
+// (1 / pi) F_t(eta, n . w_o) B plus the lights' specular lobes (render/shaders/hbe.frag).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "lucent/render/hierarchical.h"
+#include "lucent/render/render_settings.h"
+#include "lucent/render/scene.h"
+
+namespace lucent::render {
+
+/// Frame-by-frame renderer; needs a current OpenGL 4.5 core context for every call.
+class HierarchicalRenderer {
+ public:
+  HierarchicalRenderer();
+  ~HierarchicalRenderer();
+  HierarchicalRenderer(const HierarchicalRenderer&) = delete;
+  HierarchicalRenderer& operator=(const HierarchicalRenderer&) = delete;
+
+  /// Builds the hierarchy, uploads the mesh, compiles the programs. Throws lucent::Error on bad
+  /// options, an empty mesh, no light or more than 16 lights.
+  void setup(const Scene& scene, const hbe::Options& options = {});
+  void set_camera(const Camera& camera);  ///< same size as at setup
+  void set_lights(const std::vector<Light>& lights);
+  void set_material(const materials::Material& material);
+  void set_geometry(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals);
+
+  /// One frame: the solve (hbe::Solver::solve), the upload, the draw.
+  void render_frame();
+
+  ImageRgb read_image() const;                ///< linear RGB, row 0 at the top
+  std::vector<std::uint8_t> read_mask() const;  ///< 1 where a pixel sees the object
+  void present(float exposure, int width, int height) const;
+
+  const hbe::Stats& stats() const;  ///< the solve's, last frame
+  double upload_ms() const;         ///< last frame's B upload
+  double draw_ms() const;           ///< last frame's draw (glFinish + wall clock)
+  const hbe::Solver& solver() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// One frame in a headless context of its own (fills `stats` when given: technique
+/// "hierarchical", the phases' times, links and form-factor counts).
+ImageRgb render_hierarchical(const Scene& scene, const hbe::Options& options,
+                             RenderStats* stats = nullptr);
+
+}  // namespace lucent::render
