@@ -82,7 +82,7 @@ int Viewer::run() {
     // input, a finished reference pass (the worker needs the CPU more than the window does) and,
     // now and then, to watch the material file.
     const bool accumulating = (technique_ == "maps" && maps_ && (deformer_ || !maps_->converged())) ||
-                              (technique_ == "sh" && deformer_);
+                              ((technique_ == "sh" || technique_ == "hierarchical") && deformer_);
     if (accumulating) {
       glfwPollEvents();
     } else {
@@ -150,6 +150,8 @@ void Viewer::frame() {
       }
     } else if (technique_ == "sh") {
       draw_sh();
+    } else if (technique_ == "hierarchical") {
+      draw_hierarchical();
     } else {
       draw_reference();
     }
@@ -173,6 +175,7 @@ void Viewer::run_script_step() {
   if (settling_) {
     const bool done = technique_ == "maps" ? (maps_ && maps_->converged())
                       : technique_ == "sh" ? (sh_ && sh_->stats().frames > 0)
+                      : technique_ == "hierarchical" ? hbe_frames_ > 0
                                            : reference_passes_ > 0;
     if (!done && now < settle_deadline_) return;
     if (!done) std::fprintf(stderr, "view: settle: still not done after %g s\n", kSettleTimeout);

@@ -30,6 +30,7 @@
 #include "lucent/materials/material.h"
 #include "lucent/materials/profile_table.h"
 #include "lucent/render/radiance_maps.h"
+#include "lucent/render/hierarchical_renderer.h"
 #include "lucent/render/sh_renderer.h"
 #include "lucent/render/tone_map.h"
 
@@ -226,6 +227,7 @@ class Viewer {
   void run_script_step();
   void draw_ui();
   void draw_reference();
+  void draw_hierarchical();  // the same for the hierarchical technique (its solve on the CPU)
   void draw_sh();        // sync the scene into the sh renderer, one frame, present
   void apply_geometry(); // scene_.mesh changed: the maps (and sh at its next frame) take it
 
@@ -262,6 +264,11 @@ class Viewer {
   std::unique_ptr<RadianceMapRenderer> maps_;
   std::unique_ptr<ShRenderer> sh_;  // made when sh is first chosen; remade on a new window size
   int sh_width_ = 0, sh_height_ = 0;
+  std::unique_ptr<HierarchicalRenderer> hbe_;
+  int hbe_width_ = 0, hbe_height_ = 0;
+  long hbe_frames_ = 0;
+  std::string material_version_seen_;  // the material the hierarchical solver has
+  std::uint64_t hbe_geometry_version_ = 0;
   std::uint64_t geometry_version_ = 0, sh_geometry_version_ = 0;
   std::unique_ptr<ReferenceWorker> reference_;
   FileWatcher watcher_;

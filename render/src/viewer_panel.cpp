@@ -39,10 +39,12 @@ void Viewer::draw_ui() {
   if (ImGui::Button("load")) load_material(material_path_.data());
 
   // Technique and model.
-  int technique = technique_ == "maps" ? 0 : technique_ == "sh" ? 1 : 2;
+  int technique = technique_ == "maps" ? 0 : technique_ == "sh" ? 1 : technique_ == "hierarchical" ? 3 : 2;
   if (ImGui::RadioButton("radiance maps", &technique, 0)) set_technique("maps");
   ImGui::SameLine();
   if (ImGui::RadioButton("SH fast", &technique, 1)) set_technique("sh");
+  ImGui::SameLine();
+  if (ImGui::RadioButton("hierarchical", &technique, 3)) set_technique("hierarchical");
   ImGui::SameLine();
   if (ImGui::RadioButton("CPU reference", &technique, 2)) set_technique("reference");
   int model = settings_.model == DiffusionModel::kDirectionalDipole ? 0
@@ -140,6 +142,14 @@ void Viewer::draw_ui() {
     if (s.uncovered_fraction > 0) {
       ImGui::Text("unseen by every layer: %.1f%% of pixels", 100 * s.uncovered_fraction);
     }
+  } else if (technique_ == "hierarchical" && hbe_) {
+    const hbe::Stats& s = hbe_->stats();
+    ImGui::Text("%d triangles, %ld links", s.triangles, s.links);
+    ImGui::Text("link        %8.2f ms", s.link_ms);
+    ImGui::Text("irradiance  %8.2f ms", s.irradiance_ms);
+    ImGui::Text("gather+push %8.2f ms", s.pull_ms + s.gather_ms + s.push_ms);
+    ImGui::Text("draw        %8.2f ms", hbe_->draw_ms());
+    ImGui::Text("window frame %7.1f ms", frame_ms_);
   } else if (technique_ == "sh" && sh_) {
     const ShStats& s = sh_->stats();
     const ShPassTimes& t = s.last_wall;

@@ -5,8 +5,9 @@
 namespace lucent::render::viewer_detail {
 
 void Viewer::set_technique(const std::string& technique) {
-  if (technique != "maps" && technique != "sh" && technique != "reference") {
-    throw Error("technique: expected maps, sh or reference, got '" + technique + "'");
+  if (technique != "maps" && technique != "sh" && technique != "hierarchical" &&
+      technique != "reference") {
+    throw Error("technique: expected maps, sh, hierarchical or reference, got '" + technique + "'");
   }
   technique_ = technique;
   // Same scene, another technique: the cached reference stays valid for the difference view.
@@ -56,8 +57,60 @@ void Viewer::draw_sh() {
   }
 }
 
+// The hierarchical technique: its hierarchy and links are built on first use (and on a new window
+// size, which its targets have); the scene goes in before every frame, the mesh when it changed.
+void Viewer::draw_hierarchical() {
+  try {
+    if (!hbe_ || hbe_width_ != scene_.camera.width || hbe_height_ != scene_.camera.height) {
+      hbe_.reset();
+      auto r = std::make_unique<HierarchicalRenderer>();
+      r->setup(scene_, options_.hbe);
+      hbe_ = std::move(r);
+      hbe_width_ = scene_.camera.width;
+      hbe_height_ = scene_.camera.height;
+      hbe_geometry_version_ = geometry_version_;
+      material_version_seen_.clear();
+    }
+    hbe_->set_camera(scene_.camera);
+    hbe_->set_lights(scene_.lights);
+    if (hbe_geometry_version_ != geometry_version_) {
+      hbe_->set_geometry(scene_.mesh.positions, scene_.mesh.normals);
+      hbe_geometry_version_ = geometry_version_;
+    }
+    // A new material (library, file or the panel's sliders) re-links: compare its coefficients.
+    std::string key = std::to_string(scene_.material.ior);
+    for (int c = 0; c < 3; ++c) {
+      key += " " + std::to_string(scene_.material.sigma_a[std::size_t(c)]) + " " +
+             std::to_string(scene_.material.sigma_s_reduced[std::size_t(c)]);
+    }
+    if (material_version_seen_ != key) {
+      if (!material_version_seen_.empty()) hbe_->set_material(scene_.material);
+      material_version_seen_ = key;
+    }
+    hbe_->render_frame();
+    ++hbe_frames_;
+  } catch (const Error& e) {
+    message_ = e.what();
+    std::fprintf(stderr, "view: %s\n", e.what());
+    set_technique("maps");
+    return;
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  if (auto_exposure_) {
+    settings_.exposure = pending_.exposure = auto_exposure(hbe_->read_image());
+    auto_exposure_ = false;
+  }
+  if (show_difference_) {
+    draw_difference();
+  } else {
+    hbe_->present(settings_.exposure, width_, height_);
+  }
+}
+
 ImageRgb Viewer::technique_image() const {
-  return technique_ == "sh" && sh_ ? sh_->read_image() : maps_->read_image();
+  if (technique_ == "sh" && sh_) return sh_->read_image();
+  if (technique_ == "hierarchical" && hbe_) return hbe_->read_image();
+  return maps_->read_image();
 }
 
 void Viewer::draw_reference() {
@@ -88,6 +141,8 @@ void Viewer::draw_difference() {
         "pass, come back";
     if (technique_ == "sh") {
       sh_->present(settings_.exposure, width_, height_);
+    } else if (technique_ == "hierarchical") {
+      hbe_->present(settings_.exposure, width_, height_);
     } else {
       maps_->present(settings_.exposure, width_, height_);
     }
@@ -122,6 +177,9 @@ void Viewer::draw_difference() {
       if (technique_ == "sh") {
         std::printf("view: sh against the reference (%d passes): %s\n", reference_passes_,
                     difference_text_.c_str());
+      } else if (technique_ == "hierarchical") {
+        std::printf("view: hierarchical against the reference (%d passes): %s\n",
+                    reference_passes_, difference_text_.c_str());
       } else {
         std::printf("view: maps (frame %d) against the reference (%d passes): %s\n",
                     maps_->accumulated_frames(), reference_passes_, difference_text_.c_str());

@@ -194,6 +194,23 @@ TEST_F(ViewCommand, ShowsTheShTechniqueDeformsItAndComparesItWithTheReference) {
   EXPECT_GT(std::stod(r.out.substr(corr + 12)), 0.6) << r.out.substr(at, 300);
 }
 
+// The hierarchical technique in the window, compared with the reference without a scale.
+TEST_F(ViewCommand, ShowsTheHierarchicalTechniqueAgainstTheReference) {
+  const CommandResult r =
+      view("--material potato --light directional:1,0.2,0:3,3,3 --technique hierarchical" +
+           kTiny + " --script 'wait 2; screenshot a.png; set technique reference;"
+           " settle; set technique hierarchical; difference on; wait 31; quit'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_TRUE(fs::exists(dir_ / "a.png")) << r.out << r.err;
+  EXPECT_GT(load_shot(dir_ / "a.png").lit, 1000);
+  const std::size_t at = r.out.find("view: hierarchical against the reference");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  const std::size_t rmse = r.out.find("relative RMSE ", at);
+  ASSERT_NE(rmse, std::string::npos) << r.out;
+  // The window's reference pass is noisy (32 probes per pixel): most of this is its noise.
+  EXPECT_LT(std::stod(r.out.substr(rmse + 14)), 0.3) << r.out.substr(at, 200);
+}
+
 TEST_F(ViewCommand, BadInputFailsWithOneLine) {
   CommandResult r = view("--material no_such_material --light directional:0,0,1:1,1,1");
   EXPECT_NE(r.exit_code, 0);

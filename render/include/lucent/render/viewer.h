@@ -17,6 +17,7 @@
 #include "lucent/render/reference_renderer.h"
 #include "lucent/render/render_settings.h"
 #include "lucent/render/scene.h"
+#include "lucent/render/hierarchical.h"
 #include "lucent/render/sh_renderer.h"
 #include "lucent/render/viewer_controls.h"
 
@@ -30,7 +31,8 @@ struct ViewerOptions {
   ReferenceOptions reference;      ///< surface samples per pass, threads and seed for the reference
   OrbitView view;                  ///< --view
   double object_size_mm = 100;     ///< the mesh's bounding-box diagonal as loaded
-  std::string technique = "maps";  ///< maps | sh | reference
+  std::string technique = "maps";  ///< maps | sh | hierarchical | reference
+  hbe::Options hbe;                ///< --technique hierarchical: oracle, form factor, mode
   ShOptions sh;                    ///< --technique sh: shadow map, cube map, depth blur, Fresnel
   float deform_amplitude = 0;      ///< sine deformer: fraction of the diagonal; 0 = off
   /// Actions, one per frame, separated by ';' (tests and demos drive the window with them):
