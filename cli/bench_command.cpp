@@ -6,6 +6,7 @@
 #include "lucent/materials/atomic_file.h"
 #include "lucent/fit/fit_bench.h"
 #include "lucent/render/render_bench.h"
+#include "lucent/render/tradeoff_bench.h"
 
 namespace lucent::cli {
 
@@ -63,6 +64,42 @@ void register_bench_command(CLI::App& app) {
     const int n = render::run_render_bench(*render_options, std::cout);
     std::cout << "bench render: " << n << " meshes; wrote " << render_options->out_csv.string()
               << "\n";
+  });
+
+  auto tradeoff = std::make_shared<render::TradeoffBenchOptions>();
+  auto sweep = std::make_shared<std::string>("full");
+  CLI::App* tradeoff_cmd = bench->add_subcommand(
+      "tradeoff",
+      "Every technique (maps with each model, sh, hierarchical, the reference) over a sweep of "
+      "its knobs on a set of scenes, against a converged CPU reference: time per frame, time to "
+      "the image and to convergence, relative RMSE (sh: after the best scale, with correlation) "
+      "-> tradeoff.csv, tradeoff.png/.svg and tradeoff_summary.md in --out-dir");
+  tradeoff_cmd->add_option("--out-dir", tradeoff->out_dir, "output folder")->capture_default_str();
+  tradeoff_cmd
+      ->add_option("--scenes", tradeoff->scenes,
+                   "MESH/MATERIAL/LIGHTING, LIGHTING directional, point or env (a procedural "
+                   "sky); the first gets the full sweep")
+      ->delimiter(',')
+      ->capture_default_str();
+  tradeoff_cmd->add_option("--sweep", *sweep, "full, short or tiny (knob settings per technique)")
+      ->capture_default_str();
+  tradeoff_cmd->add_option("--size", tradeoff->size, "image size, pixels square")
+      ->capture_default_str();
+  tradeoff_cmd
+      ->add_option("--reference-samples", tradeoff->reference_samples,
+                   "probes per pixel of the converged reference")
+      ->capture_default_str();
+  tradeoff_cmd->add_option("--env-lights", tradeoff->env_lights, "lights for the environment map")
+      ->capture_default_str();
+  tradeoff_cmd->add_option("--threads", tradeoff->threads, "the reference's threads (0: all)")
+      ->capture_default_str();
+  tradeoff_cmd->callback([tradeoff, sweep] {
+    tradeoff->sweep = render::parse_tradeoff_sweep(*sweep);
+    check_output_folder(tradeoff->out_dir / "tradeoff.csv");  // before the sweep, not after
+    const auto rows = render::run_tradeoff_bench(*tradeoff, std::cout);
+    std::cout << "bench tradeoff: " << rows.size() << " images; wrote "
+              << (tradeoff->out_dir / "tradeoff.csv").string()
+              << ", tradeoff.png, tradeoff.svg and tradeoff_summary.md\n";
   });
 }
 

@@ -5,6 +5,7 @@
 // clang-format off
 #include "gl_api.h"  // first: GLFW must not pull in the legacy GL header
 #define GLFW_INCLUDE_NONE
+#include <functional>
 #include <GLFW/glfw3.h>
 // clang-format on
 #include <imgui.h>
@@ -18,6 +19,7 @@
 #include <condition_variable>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <sstream>
@@ -214,6 +216,12 @@ struct GlfwSession {
 
 constexpr std::array<int, 6> kMapSizes = {64, 128, 256, 512, 1024, 2048};
 
+// The window size and mesh version a frame-by-frame renderer (sh, hierarchical) was made for.
+struct FrameTarget {
+  int width = 0, height = 0;
+  std::uint64_t geometry_version = 0;
+};
+
 class Viewer {
  public:
   explicit Viewer(const ViewerOptions& options);
@@ -229,6 +237,9 @@ class Viewer {
   void draw_reference();
   void draw_hierarchical();  // the same for the hierarchical technique (its solve on the CPU)
   void draw_sh();        // sync the scene into the sh renderer, one frame, present
+  void draw_technique_frame(const std::function<void()>& frame,
+                            const std::function<ImageRgb()>& image,
+                            const std::function<void()>& present);
   void apply_geometry(); // scene_.mesh changed: the maps (and sh at its next frame) take it
 
   void view_changed();
@@ -263,13 +274,12 @@ class Viewer {
   std::string technique_;
   std::unique_ptr<RadianceMapRenderer> maps_;
   std::unique_ptr<ShRenderer> sh_;  // made when sh is first chosen; remade on a new window size
-  int sh_width_ = 0, sh_height_ = 0;
+  FrameTarget sh_target_;
   std::unique_ptr<HierarchicalRenderer> hbe_;
-  int hbe_width_ = 0, hbe_height_ = 0;
+  FrameTarget hbe_target_;
   long hbe_frames_ = 0;
   std::string material_version_seen_;  // the material the hierarchical solver has
-  std::uint64_t hbe_geometry_version_ = 0;
-  std::uint64_t geometry_version_ = 0, sh_geometry_version_ = 0;
+  std::uint64_t geometry_version_ = 0;
   std::unique_ptr<ReferenceWorker> reference_;
   FileWatcher watcher_;
   double last_watch_ = 0;

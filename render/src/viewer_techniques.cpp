@@ -16,29 +16,37 @@ void Viewer::set_technique(const std::string& technique) {
   scene_version_ = version;
 }
 
-// The sh renderer keeps nothing between frames but its GL objects: the scene goes in before every
-// frame (uniform uploads), the mesh when it changed, and a new window size remakes it (its targets
-// have the camera's size).
-void Viewer::draw_sh() {
+namespace {
+
+// Makes `renderer` on first use and anew on a new window size (its targets have the camera's
+// size), and sends it the mesh when that changed since it last had it. Returns true when made.
+template <class Renderer, class Options>
+bool keep_current(std::unique_ptr<Renderer>& renderer, FrameTarget& target, const Scene& scene,
+                  const Options& options, std::uint64_t geometry_version) {
+  if (renderer && target.width == scene.camera.width && target.height == scene.camera.height) {
+    if (target.geometry_version != geometry_version) {
+      renderer->set_geometry(scene.mesh.positions, scene.mesh.normals);
+      target.geometry_version = geometry_version;
+    }
+    return false;
+  }
+  renderer.reset();
+  auto made = std::make_unique<Renderer>();
+  made->setup(scene, options);
+  renderer = std::move(made);
+  target = {scene.camera.width, scene.camera.height, geometry_version};
+  return true;
+}
+
+}  // namespace
+
+// A frame of a technique that fails (a GL error, a scene it refuses) says why and hands over to
+// the maps; otherwise its image goes on screen (or the difference view).
+void Viewer::draw_technique_frame(const std::function<void()>& frame,
+                                  const std::function<ImageRgb()>& image,
+                                  const std::function<void()>& present) {
   try {
-    if (!sh_ || sh_width_ != scene_.camera.width ||
-        sh_height_ != scene_.camera.height) {
-      sh_.reset();
-      auto sh = std::make_unique<ShRenderer>();
-      sh->setup(scene_, options_.sh);
-      sh_ = std::move(sh);
-      sh_width_ = scene_.camera.width;
-      sh_height_ = scene_.camera.height;
-      sh_geometry_version_ = geometry_version_;
-    }
-    sh_->set_camera(scene_.camera);
-    sh_->set_lights(scene_.lights);
-    sh_->set_material(scene_.material);
-    if (sh_geometry_version_ != geometry_version_) {
-      sh_->set_geometry(scene_.mesh.positions, scene_.mesh.normals);
-      sh_geometry_version_ = geometry_version_;
-    }
-    sh_->render_frame();
+    frame();
   } catch (const Error& e) {
     message_ = e.what();
     std::fprintf(stderr, "view: %s\n", e.what());
@@ -47,64 +55,56 @@ void Viewer::draw_sh() {
   }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   if (auto_exposure_) {
-    settings_.exposure = pending_.exposure = auto_exposure(sh_->read_image());
+    settings_.exposure = pending_.exposure = auto_exposure(image());
     auto_exposure_ = false;
   }
   if (show_difference_) {
     draw_difference();
   } else {
-    sh_->present(settings_.exposure, width_, height_);
+    present();
   }
 }
 
+// The sh renderer keeps nothing between frames but its GL objects: the scene goes in before every
+// frame (uniform uploads).
+void Viewer::draw_sh() {
+  draw_technique_frame(
+      [&] {
+        keep_current(sh_, sh_target_, scene_, options_.sh, geometry_version_);
+        sh_->set_camera(scene_.camera);
+        sh_->set_lights(scene_.lights);
+        sh_->set_material(scene_.material);
+        sh_->render_frame();
+      },
+      [&] { return sh_->read_image(); },
+      [&] { sh_->present(settings_.exposure, width_, height_); });
+}
+
 // The hierarchical technique: its hierarchy and links are built on first use (and on a new window
-// size, which its targets have); the scene goes in before every frame, the mesh when it changed.
+// size); a new material re-links.
 void Viewer::draw_hierarchical() {
-  try {
-    if (!hbe_ || hbe_width_ != scene_.camera.width || hbe_height_ != scene_.camera.height) {
-      hbe_.reset();
-      auto r = std::make_unique<HierarchicalRenderer>();
-      r->setup(scene_, options_.hbe);
-      hbe_ = std::move(r);
-      hbe_width_ = scene_.camera.width;
-      hbe_height_ = scene_.camera.height;
-      hbe_geometry_version_ = geometry_version_;
-      material_version_seen_.clear();
-    }
-    hbe_->set_camera(scene_.camera);
-    hbe_->set_lights(scene_.lights);
-    if (hbe_geometry_version_ != geometry_version_) {
-      hbe_->set_geometry(scene_.mesh.positions, scene_.mesh.normals);
-      hbe_geometry_version_ = geometry_version_;
-    }
-    // A new material (library, file or the panel's sliders) re-links: compare its coefficients.
-    std::string key = std::to_string(scene_.material.ior);
-    for (int c = 0; c < 3; ++c) {
-      key += " " + std::to_string(scene_.material.sigma_a[std::size_t(c)]) + " " +
-             std::to_string(scene_.material.sigma_s_reduced[std::size_t(c)]);
-    }
-    if (material_version_seen_ != key) {
-      if (!material_version_seen_.empty()) hbe_->set_material(scene_.material);
-      material_version_seen_ = key;
-    }
-    hbe_->render_frame();
-    ++hbe_frames_;
-  } catch (const Error& e) {
-    message_ = e.what();
-    std::fprintf(stderr, "view: %s\n", e.what());
-    set_technique("maps");
-    return;
-  }
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  if (auto_exposure_) {
-    settings_.exposure = pending_.exposure = auto_exposure(hbe_->read_image());
-    auto_exposure_ = false;
-  }
-  if (show_difference_) {
-    draw_difference();
-  } else {
-    hbe_->present(settings_.exposure, width_, height_);
-  }
+  draw_technique_frame(
+      [&] {
+        if (keep_current(hbe_, hbe_target_, scene_, options_.hbe, geometry_version_)) {
+          material_version_seen_.clear();
+        }
+        hbe_->set_camera(scene_.camera);
+        hbe_->set_lights(scene_.lights);
+        // A new material (library, file or the panel's sliders): compare its coefficients.
+        std::string key = std::to_string(scene_.material.ior);
+        for (int c = 0; c < 3; ++c) {
+          key += " " + std::to_string(scene_.material.sigma_a[std::size_t(c)]) + " " +
+                 std::to_string(scene_.material.sigma_s_reduced[std::size_t(c)]);
+        }
+        if (material_version_seen_ != key) {
+          if (!material_version_seen_.empty()) hbe_->set_material(scene_.material);
+          material_version_seen_ = key;
+        }
+        hbe_->render_frame();
+        ++hbe_frames_;
+      },
+      [&] { return hbe_->read_image(); },
+      [&] { hbe_->present(settings_.exposure, width_, height_); });
 }
 
 ImageRgb Viewer::technique_image() const {

@@ -21,3 +21,6 @@ endforeach()
 lucent_add_test(hierarchical_renderer_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/hierarchical_renderer_test.cpp
   LIBS lucent::render lucent::materials OpenGL::OpenGL)
+lucent_add_test(tradeoff_bench_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/tradeoff_bench_test.cpp
+  LIBS lucent::render lucent::materials OpenGL::OpenGL)
