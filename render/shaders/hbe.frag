@@ -6,6 +6,7 @@
 #include "fresnel.glsl"
 #include "environment.glsl"
 #include "specular.glsl"
+#include "area_light.glsl"
 
 in vec3 f_position;
 in vec3 f_normal;
@@ -19,7 +20,8 @@ uniform bool u_specular;
 uniform bool u_has_environment;
 uniform sampler2D u_environment;
 uniform int u_light_count;
-uniform vec4 u_light_position[LUCENT_MAX_LIGHTS];  // w 1: point (mm), w 0: direction toward it
+// w 1: point (mm), w 0: direction toward it, w >= 2: area light slot w - 2 (area_light.glsl)
+uniform vec4 u_light_position[LUCENT_MAX_LIGHTS];
 uniform vec3 u_light_radiance[LUCENT_MAX_LIGHTS];
 
 void main() {
@@ -34,6 +36,10 @@ void main() {
   if (u_specular && u_roughness > 0.0 && cos_o > 0.0) {
     for (int l = 0; l < u_light_count; ++l) {
       vec4 p = u_light_position[l];
+      if (p.w > 1.5) {
+        L += u_light_radiance[l] * area_specular(area_slot(p), x_o, n_o, w_o, u_roughness, u_eta);
+        continue;
+      }
       vec3 w = p.xyz;
       vec3 E = u_light_radiance[l];
       if (p.w > 0.5) {

@@ -14,6 +14,14 @@
 //   directional light: E_l = the light's irradiance on a surface facing it;
 //   point light: E_l = I (w_i . w_d) / |x_l - d_i|^2, exact for the solid angle the disc element
 //   subtends (the seed's I / |x_l - x_i|^2 assumes the disc at the surface).
+//   area light (seed 002, an extension of seed 003): the light map of frame t is the view from one
+//   point s_t of the polygon (Halton points over the frames), so the disc maps to the surface as
+//   for a point light at s_t; the irradiance there is the exact pi L F(x_i, n_i) (form_factor.glsl)
+//   divided by the fraction a of the polygon above x_i's tangent plane (s_t is visible only from
+//   that part), and the point-light mapping's cos_s / |s_t - x_i|^2 is undone. Averaged over the
+//   frames: pi L F times the fraction of that part of the polygon x_i sees: exact where the light
+//   is unoccluded (soft shadows, and the penumbra's visibility weighted by area, not by the form
+//   factor's kernel: a bias inside penumbrae only). w_i = the form factor's vector direction.
 // The result is added to the previous frame's sum (ping-pong, seed §5.3.3); alpha counts frames.
 layout(early_fragment_tests) in;
 
@@ -23,6 +31,7 @@ layout(early_fragment_tests) in;
 #include "bssrdf_ddipole.glsl"
 #include "bssrdf_dipole.glsl"
 #include "bssrdf_tabulated.glsl"
+#include "area_light.glsl"
 
 in vec3 g_position;  // x_o, mm
 in vec3 g_normal;
@@ -99,7 +108,8 @@ void main() {
   vec3 sum = vec3(0.0);
   for (int l = 0; l < u_light_count; ++l) {
     vec4 light = u_light_position[l];
-    bool is_point = light.w > 0.5;
+    bool is_point = light.w > 0.5;  // point or area (from this frame's point s_t)
+    bool is_area = light.w > 1.5;
     vec3 w_d = is_point ? normalize(light.xyz - x_o) : normalize(light.xyz);
     vec3 t1, t2;
     basis(w_d, t1, t2);
@@ -136,7 +146,19 @@ void main() {
       }
       vec3 w_i;
       vec3 E;
-      if (is_point) {
+      if (is_area) {
+        int slot = area_slot(light);
+        FormFactor ff = area_form_factor(slot, x_i, n_i);
+        vec3 to_s = light.xyz - x_i;
+        float d_s = length(to_s);
+        float cos_s = d_s > 0.0 ? dot(n_i, to_s) / d_s : 0.0;
+        float above = ff.clipped_area / area_light_area(slot);
+        if (!(ff.F > 0.0) || !(cos_s > 0.0) || !(above > 1e-6)) continue;
+        w_i = normalize(ff.vector_);
+        vec3 from_disc = light.xyz - x_d;
+        E = u_light_radiance[l] * (kPi * ff.F / above) * (d_s * d_s / cos_s) *
+            max(dot(to_s / d_s, w_d), 0.0) / dot(from_disc, from_disc);
+      } else if (is_point) {
         vec3 to_light = light.xyz - x_i;
         w_i = normalize(to_light);
         vec3 from_disc = light.xyz - x_d;

@@ -13,6 +13,7 @@
 #include "lucent/materials/error.h"
 #include "lucent/materials/fresnel.h"
 #include "lucent/materials/material.h"
+#include "area_light_irradiance.h"
 #include "reference_common.h"
 
 namespace lucent::render::hbe {
@@ -75,6 +76,9 @@ namespace {
 using Coefficients = materials::DiffusionCoefficients<double>;
 using Rgb = std::array<double, 3>;
 using Clock = std::chrono::steady_clock;
+// Shadow rays per face for an area light (area_light_irradiance.h): 16 keep a 100 mm sphere under
+// a 40 mm rect within 1% of 256 rays outside the penumbra (the control variate does most of it).
+constexpr int kAreaLightSamples = 16;
 
 double ms_since(Clock::time_point t) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
@@ -278,7 +282,22 @@ struct Solver::Impl {
       g.normalize();
       Vec3f n = mesh.normals[tri[0]] + mesh.normals[tri[1]] + mesh.normals[tri[2]];
       n = n.norm() > 0 ? Vec3f(n.normalized()) : g;
-      for (const Light& light : scene.lights) {
+      for (std::size_t l = 0; l < scene.lights.size(); ++l) {
+        const Light& light = scene.lights[l];
+        if (light.type == LightType::kArea) {
+          // kAreaLightSamples stratified shadow rays with the analytic pi F as control variate
+          // (area_light_irradiance.h), the same points every frame (no flicker); a penumbra's
+          // rare negative estimate is clamped to 0.
+          detail::AreaLightSampling sampling;
+          sampling.samples = kAreaLightSamples;
+          sampling.shadows = o.shadows;
+          const detail::AreaIrradiance a = detail::area_light_irradiance(
+              light, x, n, g, rays.get(), eps, eta, sampling,
+              detail::mix(std::uint64_t(t) * 0x9E3779B97F4A7C15ull + l));
+          const double f = std::max(a.transmitted, 0.0);
+          for (int ch = 0; ch < 3; ++ch) face_E[t][std::size_t(ch)] += f * light.radiance[ch];
+          continue;
+        }
         Vec3f w;
         double falloff = 1, distance = detail::kInf;
         if (!detail::toward_light(light, x, w, falloff, distance)) continue;

@@ -5,6 +5,7 @@
 #include <chrono>
 
 #include "gl_api.h"
+#include "gl_area_lights.h"
 #include "gl_frame.h"
 #include "gl_program.h"
 #include "lucent/materials/error.h"
@@ -61,9 +62,12 @@ struct HierarchicalRenderer::Impl {
         position[4 * l + std::size_t(k)] = p[k];
         radiance[3 * l + std::size_t(k)] = light.radiance[k];
       }
-      position[4 * l + 3] = light.type == LightType::kPoint ? 1.0f : 0.0f;
+      position[4 * l + 3] = light.type == LightType::kPoint  ? 1.0f
+                            : light.type == LightType::kArea ? float(2 + gl::area_slot(scene.lights, l))
+                                                             : 0.0f;
     }
     const GLuint id = program.id();
+    gl::upload_area_lights(id, scene.lights);
     glProgramUniform1i(id, program.location("u_light_count"), GLint(scene.lights.size()));
     glProgramUniform4fv(id, program.location("u_light_position"), kMaxLights, position.data());
     glProgramUniform3fv(id, program.location("u_light_radiance"), kMaxLights, radiance.data());
@@ -98,7 +102,8 @@ void HierarchicalRenderer::setup(const Scene& scene, const hbe::Options& options
   glVertexArrayAttribFormat(vao, 2, 3, GL_FLOAT, GL_FALSE, 0);
   glVertexArrayAttribBinding(vao, 2, 2);
   m.empty_vao = gl::create_vertex_array();
-  const std::vector<std::string> defines = {"LUCENT_MAX_LIGHTS " + std::to_string(kMaxLights)};
+  const std::vector<std::string> defines = {"LUCENT_MAX_LIGHTS " + std::to_string(kMaxLights),
+                                            gl::area_light_define()};
   m.program = gl::Program({{GL_VERTEX_SHADER, "hbe.vert"}, {GL_FRAGMENT_SHADER, "hbe.frag"}}, defines);
   m.background_program = gl::Program(
       {{GL_VERTEX_SHADER, "background.vert"}, {GL_FRAGMENT_SHADER, "background.frag"}}, defines);

@@ -130,7 +130,7 @@ void RadianceMapRenderer::Impl::upload_mesh() {
 
 void RadianceMapRenderer::Impl::build_programs() {
   const std::vector<std::string> defines = {
-      "LUCENT_MAX_LIGHTS " + std::to_string(kMaxLights),
+      "LUCENT_MAX_LIGHTS " + std::to_string(kMaxLights), gl::area_light_define(),
       "LUCENT_MAX_DIRECTIONS " + std::to_string(K),
       "LUCENT_MAX_DISC_SAMPLES " + std::to_string(settings.samples),
       settings.model == DiffusionModel::kDipole      ? "LUCENT_MODEL_DIPOLE"
@@ -289,13 +289,28 @@ void RadianceMapRenderer::Impl::upload_layers() {
 
 void RadianceMapRenderer::Impl::upload_lights() {
   L = int(scene.lights.size());
+  upload_light_cameras(1);
+  gl::upload_area_lights(radiance_program.id(), scene.lights);
+  gl::upload_area_lights(final_program.id(), scene.lights);
+  upload_disc(1, true);
+}
+
+void RadianceMapRenderer::Impl::upload_light_cameras(int t) {
   light_cams.clear();
   std::vector<float> matrices(std::size_t(kMaxLights) * 16, 0.0f);
   std::vector<float> position(std::size_t(kMaxLights) * 4, 0.0f),
       radiance_(std::size_t(kMaxLights) * 3, 0.0f), texel(std::size_t(kMaxLights) * 2, 0.0f);
   for (int l = 0; l < L; ++l) {
     const Light& light = scene.lights[std::size_t(l)];
-    if (light.type == LightType::kDirectional) {
+    if (light.type == LightType::kArea) {
+      // Frame t's light map is the view from one point of the polygon (gl_area_lights.h); the
+      // radiance pass weights what it sees with the exact form factor (radiance_map.frag).
+      const Vec3f s = gl::area_light_frame_point(light, std::size_t(l), t);
+      light_cams.push_back(detail::fitted_area_perspective(centre, radius_mm, s,
+                                                           area_light_normal(light)));
+      for (int c = 0; c < 3; ++c) position[std::size_t(l) * 4 + std::size_t(c)] = s[c];
+      position[std::size_t(l) * 4 + 3] = float(2 + gl::area_slot(scene.lights, std::size_t(l)));
+    } else if (light.type == LightType::kDirectional) {
       const Vec3f d = light.direction.normalized();
       light_cams.push_back(detail::fitted_orthographic(centre, radius_mm, d));
       position[std::size_t(l) * 4 + 0] = d.x();
@@ -326,8 +341,6 @@ void RadianceMapRenderer::Impl::upload_lights() {
   glProgramUniform4fv(f, final_program.location("u_light_position"), kMaxLights, position.data());
   glProgramUniform3fv(f, final_program.location("u_light_radiance"), kMaxLights, radiance_.data());
   glProgramUniform2fv(f, final_program.location("u_light_texel_mm"), kMaxLights, texel.data());
-
-  upload_disc(1, true);
 }
 
 void RadianceMapRenderer::Impl::upload_disc(int t, bool redraw) {

@@ -68,6 +68,12 @@ void RadianceMapRenderer::restart() {
 
 bool RadianceMapRenderer::render_frame() {
   Impl& m = *impl_;
+  const bool accumulating = m.frame < m.settings.frames;
+  if (accumulating && m.has_area_lights()) {
+    // Each accumulated frame sees the area lights from new points of their polygons.
+    m.upload_light_cameras(m.frame + 1);
+    m.light_map_valid = false;
+  }
   if (!m.light_map_valid) {
     m.timed(kLightMap, [&] { m.render_light_map(); });
     m.light_map_valid = true;

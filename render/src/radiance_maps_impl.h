@@ -10,10 +10,12 @@
 #include <sstream>
 
 #include "gl_api.h"
+#include "gl_area_lights.h"
 #include "gl_bssrdf.h"
 #include "gl_frame.h"
 #include "gl_program.h"
 #include "lucent/materials/error.h"
+#include "lucent/render/area_light.h"
 #include "lucent/render/environment.h"
 #include "lucent/render/gl_context.h"
 #include "lucent/render/radiance_maps.h"
@@ -109,6 +111,11 @@ struct RadianceMapRenderer::Impl {
   void build_radiance_maps();
   void build_final();
   void upload_lights();
+  void upload_light_cameras(int t);  ///< t: the accumulated frame (area lights' points)
+  bool has_area_lights() const {
+    return std::any_of(scene.lights.begin(), scene.lights.end(),
+                       [](const Light& l) { return l.type == LightType::kArea; });
+  }
   void upload_material();
   void upload_disc(int t, bool redraw);
   void upload_layers();

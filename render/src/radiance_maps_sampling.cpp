@@ -272,6 +272,24 @@ LayerCamera fitted_perspective(const Vec3f& centre, float radius_mm, const Vec3f
   return c;
 }
 
+LayerCamera fitted_area_perspective(const Vec3f& centre, float radius_mm, const Vec3f& eye,
+                                    const Vec3f& normal) {
+  const float r = radius_mm * 1.02f;
+  const float distance = (eye - centre).norm();
+  if (distance > 1.05f * r) return fitted_perspective(centre, radius_mm, eye);
+  LayerCamera c;
+  c.direction = -normal.normalized();
+  const float half_angle = 75.0f * std::numbers::pi_v<float> / 180.0f;
+  c.near_mm = 1e-3f * std::max(distance, r);
+  c.far_mm = distance + r;
+  c.extent_per_mm = 2 * std::tan(half_angle);
+  const Vec3f forward = normal.normalized();
+  const Vec3f up = std::abs(forward.y()) < 0.9f ? Vec3f::UnitY() : Vec3f::UnitZ();
+  c.view_proj =
+      perspective(2 * half_angle, 1.0f, c.near_mm, c.far_mm) * look_at(eye, eye + forward, up);
+  return c;
+}
+
 Mat4f camera_view_proj(const Camera& camera, const Vec3f& centre, float radius_mm) {
   const float distance = (camera.eye - centre).norm();
   const float r = radius_mm * 1.05f;

@@ -131,6 +131,11 @@ LayerCamera fitted_orthographic(const Vec3f& centre, float radius_mm, const Vec3
 /// (half-angle asin(radius / distance)); a light inside or near the sphere gets a 150 degree
 /// frustum, and surface outside it is unlit.
 LayerCamera fitted_perspective(const Vec3f& centre, float radius_mm, const Vec3f& eye);
+/// The light camera at a point `eye` of an area light emitting toward `normal`: fitted_perspective
+/// from outside the bounding sphere; from inside it (a lamp close to a large object), 150 degrees
+/// about the emitting direction (the half-space behind the polygon gets no light).
+LayerCamera fitted_area_perspective(const Vec3f& centre, float radius_mm, const Vec3f& eye,
+                                    const Vec3f& normal);
 
 /// The viewer's perspective camera with near and far planes around the sphere.
 Mat4f camera_view_proj(const Camera& camera, const Vec3f& centre, float radius_mm);

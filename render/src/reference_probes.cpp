@@ -19,6 +19,7 @@
 
 #include "lucent/materials/fresnel.h"
 #include "profile_sampling.h"
+#include "area_light_irradiance.h"
 #include "reference_common.h"
 
 namespace lucent::render::detail {
@@ -52,6 +53,7 @@ void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions
                                                ChannelBssrdf(scene.material.medium(1), model),
                                                ChannelBssrdf(scene.material.medium(2), model)};
   const bool per_light = model == DiffusionModel::kDirectionalDipole;
+  const AreaLightSampling area_sampling = area_light_sampling(options);
   const double R = density.r_max();
   const float eps = 1e-4f * std::max(mesh.bounding_radius(), 1e-6f);
   const int S = std::max(1, options.pixel_samples);
@@ -141,7 +143,21 @@ void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions
               if (!per_light) {
                 for (int c = 0; c < 3; ++c) radial[c] = bssrdf[c](x_i, n_i, n_i, x_o, n_o);
               }
-              for (const Light& light : scene.lights) {
+              for (std::size_t l = 0; l < scene.lights.size(); ++l) {
+                const Light& light = scene.lights[l];
+                if (light.type == LightType::kArea) {
+                  const AreaIrradiance a = area_light_irradiance(
+                      light, x_f, n_f, g_f, &rays, eps, eta, area_sampling,
+                      mix(key ^ (0xA2EAull + std::uint64_t(n) * 0x100000001B3ull + l)));
+                  if (a.transmitted == 0) continue;
+                  const Vec3d w_i = a.w.cast<double>();
+                  const double factor = a.transmitted / pdf;
+                  for (int c = 0; c < 3; ++c) {
+                    const double s_d = per_light ? bssrdf[c](x_i, n_i, w_i, x_o, n_o) : radial[c];
+                    sum[c] += factor * light.radiance[c] * s_d;
+                  }
+                  continue;
+                }
                 Vec3f w;
                 double scale = 1, distance = kInf;
                 if (!toward_light(light, x_f, w, scale, distance)) continue;

@@ -22,6 +22,7 @@
 #include "lucent/materials/fresnel.h"
 #include "lucent/materials/specular.h"
 #include "lucent/render/environment.h"
+#include "area_light_irradiance.h"
 #include "reference_common.h"
 
 namespace lucent::render {
@@ -148,12 +149,42 @@ class ClusterTree {
 };
 
 // The specular lobe of every light at a pixel's point (materials/specular.h), with a shadow ray.
-Vec3f specular_radiance(const Scene& scene, const RayScene& rays, const PixelHit& hit, float eps) {
+// Area lights: the mean over kAreaSpecularSamples stratified points of the polygon (shadow ray,
+// GGX, L cos_p / r^2 dA), unbiased like the subsurface term.
+constexpr int kAreaSpecularSamples = 16;
+
+Vec3f specular_radiance(const Scene& scene, const RayScene& rays, const PixelHit& hit, float eps,
+                        std::uint64_t key) {
   Vec3f sum = Vec3f::Zero();
   if (!scene.specular || !(scene.roughness > 0)) return sum;
   const double cos_o = hit.n_o.dot(hit.w_o);
   if (!(cos_o > 0)) return sum;
+  const auto lobe = [&](const Vec3f& w, double cos_i) {
+    const Vec3f h = (w + hit.w_o).normalized();
+    return materials::ggx_reflection<double>(cos_i, cos_o, hit.n_o.dot(h), h.dot(w),
+                                             scene.roughness, scene.material.ior);
+  };
   for (const Light& light : scene.lights) {
+    if (light.type == LightType::kArea) {
+      const Vec3f normal_l = area_light_normal(light);
+      const double area = area_light_area(light);
+      const int S = kAreaSpecularSamples, side = 4;  // a 4 x 4 jittered grid
+      for (int j = 0; j < S; ++j) {
+        const std::uint64_t k = mix(key + std::uint64_t(j) * 0x9E3779B97F4A7C15ull);
+        const Vec3f p = area_light_point(light, (j % side + uniform01(k)) / side,
+                                         (j / side + uniform01(k ^ 7)) / side);
+        const Vec3f d = p - hit.x_o;
+        const double r = d.norm();
+        if (!(r > 0)) continue;
+        const Vec3f w = d / float(r);
+        const double cos_i = hit.n_o.dot(w), cos_p = -normal_l.dot(w);
+        if (!(cos_i > 0) || !(cos_p > 0)) continue;
+        const Vec3f offset = hit.g_o.dot(w) >= 0 ? hit.g_o : Vec3f(-hit.g_o);
+        if (rays.occluded(hit.x_o + eps * offset, w, r - 2 * eps)) continue;
+        sum += float(lobe(w, cos_i) * cos_p / (r * r) * area / S) * light.radiance;
+      }
+      continue;
+    }
     Vec3f w;
     double scale = 1, distance = kInf;
     if (!toward_light(light, hit.x_o, w, scale, distance)) continue;
@@ -161,10 +192,7 @@ Vec3f specular_radiance(const Scene& scene, const RayScene& rays, const PixelHit
     if (!(cos_i > 0)) continue;
     const Vec3f offset = hit.g_o.dot(w) >= 0 ? hit.g_o : Vec3f(-hit.g_o);
     if (rays.occluded(hit.x_o + eps * offset, w, distance - eps)) continue;
-    const Vec3f h = (w + hit.w_o).normalized();
-    const double f = materials::ggx_reflection<double>(cos_i, cos_o, hit.n_o.dot(h), h.dot(w),
-                                                       scene.roughness, scene.material.ior);
-    sum += float(f * scale) * light.radiance;
+    sum += float(lobe(w, cos_i) * scale) * light.radiance;
   }
   return sum;
 }
@@ -436,6 +464,7 @@ ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
   const std::size_t groups = per_light ? scene.lights.size() : (scene.lights.empty() ? 0 : 1);
   const std::size_t N = std::size_t(options.surface_samples);
   const SurfaceSampler sampler(mesh);
+  const AreaLightSampling area_sampling = area_light_sampling(options);
   const double area_per_sample = sampler.area() / double(N);
 
   ImageRgb mean(W, H, 0.0f);
@@ -491,6 +520,21 @@ ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
           r.E = {0, 0, 0};
           for (std::size_t l = first_light; l < end_light; ++l) {
             const Light& light = scene.lights[l];
+            if (light.type == LightType::kArea) {
+              // The area light's own estimator (area_light_irradiance.h); the plain mean, since
+              // the clusters weight by E and the control variate can make it negative.
+              AreaLightSampling sampling = area_sampling;
+              sampling.control_variate = false;
+              const AreaIrradiance a = area_light_irradiance(
+                  light, xs[k], ns[k], gs[k], &rays, eps, eta, sampling,
+                  mix(pass_key ^ (std::uint64_t(k) * 0x2545F4914F6CDD1Dull + l)));
+              if (!(a.transmitted > 0)) continue;
+              r.w = a.w;
+              for (int c = 0; c < 3; ++c) {
+                r.E[c] += float(area_per_sample * a.transmitted * light.radiance[c]);
+              }
+              continue;
+            }
             Vec3f w;
             double irradiance_scale = 1, distance = kInf;
             if (!toward_light(light, xs[k], w, irradiance_scale, distance)) continue;
@@ -556,7 +600,8 @@ ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
       if (options.environment_reflection && environment) {
         reflection = float(hit.fresnel_reflect) * environment_lookup(*environment, hit.reflected);
       }
-      const Vec3f specular = specular_radiance(scene, rays, hit, eps);
+      const Vec3f specular = specular_radiance(
+          scene, rays, hit, eps, mix(options.seed ^ (std::uint64_t(pass) << 40) ^ std::uint64_t(p)));
       for (int c = 0; c < 3; ++c) {
         image.data[3 * p + c] =
             float(hit.fresnel_out * accumulated[i][c]) + reflection[c] + specular[c];

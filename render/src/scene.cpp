@@ -12,6 +12,7 @@
 #include <Eigen/Geometry>
 
 #include "lucent/materials/error.h"
+#include "lucent/render/area_light.h"
 #include "lucent/render/scene.h"
 
 namespace lucent::render {
@@ -37,17 +38,41 @@ bool parse_triple(const std::string& text, Vec3f& out) {
 
 Light parse_light(const std::string& text) {
   const std::string expected =
-      "expected directional:DX,DY,DZ:R,G,B (direction toward the light) or point:X,Y,Z:R,G,B "
-      "(position in mm)";
+      "expected directional:DX,DY,DZ:R,G,B (direction toward the light), point:X,Y,Z:R,G,B "
+      "(position in mm) or rect:CX,CY,CZ:UX,UY,UZ:VX,VY,VZ:R,G,B (centre and half-edge vectors in "
+      "mm, radiance; emitting toward U x V)";
   const auto bad = [&](const std::string& why) { return Error("--light '" + text + "': " + why); };
-  const auto first = text.find(':');
-  const auto second = first == std::string::npos ? first : text.find(':', first + 1);
-  if (second == std::string::npos || text.find(':', second + 1) != std::string::npos) {
-    throw bad(expected);
+  std::vector<std::string> fields;
+  {
+    std::size_t start = 0;
+    while (true) {
+      const std::size_t colon = text.find(':', start);
+      fields.push_back(text.substr(start, colon == std::string::npos ? colon : colon - start));
+      if (colon == std::string::npos) break;
+      start = colon + 1;
+    }
   }
-  const std::string kind = text.substr(0, first);
-  const std::string where = text.substr(first + 1, second - first - 1);
-  const std::string colour = text.substr(second + 1);
+  const std::string kind = fields.front();
+  if (kind == "rect") {
+    if (fields.size() != 5) throw bad(expected);
+    Vec3f c, u, v, radiance;
+    const char* names[] = {"centre", "U", "V"};
+    Vec3f* out[] = {&c, &u, &v};
+    for (int i = 0; i < 3; ++i) {
+      if (!parse_triple(fields[std::size_t(i) + 1], *out[i])) {
+        throw bad(std::string("the ") + names[i] + " must be three comma-separated numbers; " +
+                  expected);
+      }
+    }
+    if (!parse_triple(fields[4], radiance)) {
+      throw bad("the radiance must be three comma-separated numbers R,G,B; " + expected);
+    }
+    if ((radiance.array() < 0).any()) throw bad("the radiance must not be negative");
+    return rect_light(c, u, v, radiance, "--light '" + text + "'");
+  }
+  if (fields.size() != 3) throw bad(expected);
+  const std::string& where = fields[1];
+  const std::string& colour = fields[2];
   Light light;
   if (kind == "directional") {
     light.type = LightType::kDirectional;

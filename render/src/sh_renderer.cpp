@@ -11,6 +11,7 @@
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/error.h"
 #include "lucent/materials/medium.h"
+#include "lucent/render/area_light.h"
 #include "lucent/render/sh_translucency.h"
 
 namespace lucent::render {
@@ -261,8 +262,12 @@ void ShRenderer::Impl::upload_lights() {
   std::vector<float> radiance(std::size_t(kMaxLights) * 3, 0.0f);
   int primary = 0;
   float brightest = -1;
+  // Area lights enter as point lights at their centroids (point_light_equivalent): the technique's
+  // cube map and thickness look-up follow one position per light.
+  std::vector<Light> lights;
+  for (const Light& light : scene.lights) lights.push_back(point_light_equivalent(light));
   for (int l = 0; l < L; ++l) {
-    const Light& light = scene.lights[std::size_t(l)];
+    const Light& light = lights[std::size_t(l)];
     float* p = &position[std::size_t(l) * 4];
     float e = luminance(light.radiance);
     if (light.type == LightType::kDirectional) {
@@ -275,7 +280,7 @@ void ShRenderer::Impl::upload_lights() {
     for (int c = 0; c < 3; ++c) radiance[std::size_t(l) * 3 + std::size_t(c)] = light.radiance[c];
     if (e > brightest) brightest = e, primary = l;
   }
-  const Light& p = scene.lights[std::size_t(primary)];
+  const Light& p = lights[std::size_t(primary)];
   const float S = float(options.shadow_map_size);
   if (p.type == LightType::kDirectional) {
     light_camera = detail::fitted_orthographic(centre, radius_mm, p.direction.normalized());

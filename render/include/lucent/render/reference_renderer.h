@@ -54,6 +54,11 @@ struct ReferenceOptions {
   std::uint64_t seed = 1;        ///< same seed, same image, for any number of threads
   int passes = 1;         ///< progressive: each pass draws N new samples; image = running mean
   bool shadows = true;    ///< shadow rays from each sample toward each light
+  /// Area lights: points on the polygon (one shadow ray each) per surface point, stratified, and
+  /// the analytic pi L F as a control variate (area_light_irradiance.h: unbiased either way; with
+  /// it a fully visible light costs no noise). The kArea sampler always uses the plain mean.
+  int area_light_samples = 4;
+  bool area_light_control_variate = true;
   float exposure = 1.0f;  ///< linear scale of the returned images (1: radiance as computed)
   /// Hierarchical clustering: a node of bounding radius r at distance d is used as a whole when
   /// r < cluster_ratio * d. 0 = every sample evaluated (brute force: 5x slower at 20k samples,

@@ -33,14 +33,18 @@ struct Mesh {
   double surface_area() const;           ///< mm^2
 };
 
-enum class LightType { kDirectional, kPoint };
+enum class LightType { kDirectional, kPoint, kArea };
 
 struct Light {
   LightType type = LightType::kDirectional;
   Vec3f direction{0, 0, 1};  ///< directional: unit, from the object toward the light
   Vec3f position{0, 0, 0};   ///< point: mm, in the mesh's (scaled) frame
   Vec3f radiance{1, 1, 1};   ///< directional: irradiance on a surface facing it (W/mm^2, relative);
-                             ///< point: intensity (W/sr, relative)
+                             ///< point: intensity (W/sr, relative); area: radiance (W/mm^2/sr)
+  /// area: the emitting polygon, mm (convex, planar, 3..kMaxPolygonVertices vertices), emitting
+  /// one-sided toward its winding normal (right-hand rule); the irradiance at an unoccluded point
+  /// is pi L F (polygon_form_factor.h). Made by area_light / rect_light (area_light.h).
+  std::vector<Vec3f> polygon;
 };
 
 /// Orthographic light map / perspective camera conventions are the techniques' business; this is the
@@ -73,7 +77,9 @@ struct Scene {
   Vec3f backdrop{0, 0, 0};  ///< radiance of the background where no environment map is given
 };
 
-/// Parses `directional:DX,DY,DZ:R,G,B` or `point:X,Y,Z:R,G,B`; throws lucent::Error naming --light.
+/// Parses `directional:DX,DY,DZ:R,G,B`, `point:X,Y,Z:R,G,B` or
+/// `rect:CX,CY,CZ:UX,UY,UZ:VX,VY,VZ:R,G,B` (centre and half-edge vectors in mm, radiance; emits
+/// toward U x V); throws lucent::Error naming --light.
 Light parse_light(const std::string& text);
 
 /// Built-in meshes and files: "sphere" (an icosphere of 5120 triangles; "sphere:L" has 20 x 4^L,
