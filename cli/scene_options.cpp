@@ -77,8 +77,10 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
       ->capture_default_str();
   cmd->add_option("--light", args->lights,
                   "directional:DX,DY,DZ:R,G,B (direction toward the light; R,G,B irradiance on a "
-                  "surface facing it) or point:X,Y,Z:R,G,B (position in mm from the mesh centre; "
-                  "R,G,B intensity per sr); repeatable");
+                  "surface facing it), point:X,Y,Z:R,G,B (position in mm from the mesh centre; "
+                  "R,G,B intensity per sr) or rect:CX,CY,CZ:UX,UY,UZ:VX,VY,VZ:R,G,B (an area "
+                  "light: centre and half-edge vectors in mm, R,G,B radiance, emitting toward U x "
+                  "V); repeatable");
   cmd->add_option("--env", args->env,
                   "FILE[:L]: lat-long environment map (.exr or .hdr), shown as background and lit "
                   "by L importance-sampled directional lights (default L = 16)");

@@ -66,7 +66,8 @@ struct ContourSum {
 
   void edge(const Vec3& a, const Vec3& b) {
     using std::atan2;
-    area += a.cross(b);
+    // About the first vertex, not x: a distant receiver's long vectors would cancel in float.
+    area += (a - first).cross(b - first);
     const Vec3 c = b.cross(a);
     const T length = c.norm();
     // An edge through x or seen end-on subtends no angle (and has no direction).
