@@ -2,6 +2,7 @@
 // renderer drawing into it, Dear ImGui's panel on top, and the CPU reference on a worker thread.
 #include "lucent/render/viewer.h"
 
+#include "lucent/render/area_light.h"
 #include "viewer_impl.h"
 
 #include "lucent/materials/atomic_file.h"
@@ -228,6 +229,8 @@ void Viewer::handle_keys() {
     if (key == GLFW_KEY_H) show_ui_ = !show_ui_;
     if (key == GLFW_KEY_D) show_difference_ = !show_difference_;
     if (key == GLFW_KEY_R) scene_changed();
+    if (key == GLFW_KEY_LEFT_BRACKET) scale_selected_light(1 / 1.25f);  // an area light's size
+    if (key == GLFW_KEY_RIGHT_BRACKET) scale_selected_light(1.25f);
     if (key == GLFW_KEY_S) screenshot_path_ = next_screenshot_path();  // taken after drawing
   }
 }
@@ -319,6 +322,8 @@ void Viewer::set_parameter(const std::string& name, const std::string& value) {
   const float v = parse_float(value, "set " + name);
   if (name == "exposure") {
     settings_.exposure = pending_.exposure = v;
+  } else if (name == "light_scale") {
+    scale_selected_light(v);
   } else if (name == "size") {
     set_object_size(v);
   } else if (name == "deform") {
@@ -342,7 +347,8 @@ void Viewer::set_parameter(const std::string& name, const std::string& value) {
     else
       throw Error(
           "--script: set " + name +
-          ": expected N, M, q, K, Ws, Wl, T, exposure, size, deform, disc, technique or model");
+          ": expected N, M, q, K, Ws, Wl, T, exposure, size, deform, light_scale, disc, technique or "
+          "model");
     next.validate();
     settings_ = pending_ = next;
     rebuild_maps();
@@ -388,12 +394,25 @@ void Viewer::set_object_size(double mm) {
       light.position *= s;
       light.radiance *= s * s;
     }
+    // An area light scaled about the centre keeps the solid angle it subtends: same radiance.
+    for (Vec3f& p : light.polygon) p *= s;
+    if (light.type == LightType::kArea) light.position = area_light_centroid(light);
   }
   if (deformer_) deformer_.emplace(rest_mesh_, deform_amplitude_);
   scene_.mesh = rest_mesh_;
   apply_geometry();
   if (maps_) maps_->set_lights(scene_.lights);
   view_changed();
+  scene_changed();
+}
+
+void Viewer::scale_selected_light(float scale) {
+  Light& light = scene_.lights[std::size_t(selected_light_)];
+  if (!resize_light(light, scale)) {
+    message_ = "light size: only an area light (rect) can be resized, by a scale > 0";
+    return;
+  }
+  if (maps_) maps_->set_lights(scene_.lights);
   scene_changed();
 }
 

@@ -6,6 +6,7 @@
 #include <numbers>
 #include <system_error>
 #include <utility>
+#include "lucent/render/area_light.h"
 
 namespace lucent::render {
 namespace {
@@ -31,6 +32,19 @@ Camera OrbitView::camera(const Mesh& mesh, int width, int height) const {
 }
 
 void drag_light(Light& light, float d_azimuth_deg, float d_elevation_deg) {
+  if (light.type == LightType::kArea) {
+    // The polygon turns rigidly with its centroid (so a lamp facing the object keeps facing it).
+    Light centre;
+    centre.type = LightType::kPoint;
+    centre.position = area_light_centroid(light);
+    drag_light(centre, d_azimuth_deg, d_elevation_deg);
+    const Eigen::Quaternionf turn =
+        Eigen::Quaternionf::FromTwoVectors(area_light_centroid(light), centre.position);
+    for (Vec3f& p : light.polygon) p = turn * p;
+    light.position = area_light_centroid(light);
+    light.direction = area_light_normal(light);
+    return;
+  }
   Vec3f& v = light.type == LightType::kDirectional ? light.direction : light.position;
   const float length = v.norm();
   if (!(length > 0)) return;
@@ -41,6 +55,12 @@ void drag_light(Light& light, float d_azimuth_deg, float d_elevation_deg) {
   const float az = (azimuth + d_azimuth_deg) * kDeg;
   const float el = std::clamp(elevation + d_elevation_deg, -kMaxElevation, kMaxElevation) * kDeg;
   v = length * Vec3f(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az));
+}
+
+bool resize_light(Light& light, float scale) {
+  if (light.type != LightType::kArea || !(scale > 0) || !std::isfinite(scale)) return false;
+  transform_area_light(light, Vec3f::Zero(), scale);
+  return true;
 }
 
 SineDeformer::SineDeformer(Mesh rest, float amplitude, float waves, float speed_rad_per_s)

@@ -248,6 +248,7 @@ class Viewer {
   void set_parameter(const std::string& name, const std::string& value);
   void load_material(const std::string& source);
   void set_object_size(double mm);
+  void scale_selected_light(float scale);  ///< area lights: `[` / `]`, set light_scale S
   void set_deform(float amplitude);
   void set_technique(const std::string& technique);
   void screenshot(const std::filesystem::path& path);

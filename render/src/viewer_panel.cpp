@@ -1,5 +1,6 @@
 // The viewer's panel (Dear ImGui): material, model and technique, the radiance maps' knobs, the
 // scene, progress and the difference against the reference (viewer_impl.h).
+#include "lucent/render/area_light.h"
 #include "viewer_impl.h"
 
 namespace lucent::render::viewer_detail {
@@ -118,6 +119,14 @@ void Viewer::draw_ui() {
   if (slider_done()) set_deform(deform);
   if (scene_.lights.size() > 1) {
     ImGui::SliderInt("dragged light", &selected_light_, 0, int(scene_.lights.size()) - 1);
+  }
+  if (scene_.lights[std::size_t(selected_light_)].type == LightType::kArea) {
+    const Light& rect = scene_.lights[std::size_t(selected_light_)];
+    ImGui::Text("rect %.0f mm^2 at %.0f mm", area_light_area(rect),
+                double(area_light_centroid(rect).norm()));
+    if (ImGui::Button("smaller [")) scale_selected_light(1 / 1.25f);
+    ImGui::SameLine();
+    if (ImGui::Button("larger ]")) scale_selected_light(1.25f);
   }
   if (technique_ == "reference" && deformer_) ImGui::TextUnformatted("(the deformer pauses for the reference)");
 

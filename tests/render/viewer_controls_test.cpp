@@ -3,6 +3,8 @@
 // file watcher.
 #include "lucent/render/viewer_controls.h"
 
+#include "lucent/render/area_light.h"
+
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -119,6 +121,23 @@ TEST(FileWatcher, ReportsEachChangeOnce) {
   EXPECT_TRUE(watcher.changed());
   EXPECT_FALSE(FileWatcher().changed());
   std::filesystem::remove_all(dir);
+}
+
+TEST(DragLight, AreaLightTurnsRigidlyAndResizes) {
+  // U x V = (0,10,0) x (20,0,0) = -z: facing the origin from +z.
+  Light rect = parse_light("rect:0,0,80:0,10,0:20,0,0:1,1,1");
+  ASSERT_NEAR(area_light_normal(rect).z(), -1.0f, 1e-6f);
+  const double area = area_light_area(rect);
+  drag_light(rect, 90, 0);  // a quarter turn about +y: from +z to +x
+  EXPECT_NEAR((area_light_centroid(rect) - Vec3f(80, 0, 0)).norm(), 0.0f, 1e-3f);
+  EXPECT_NEAR(area_light_normal(rect).x(), -1.0f, 1e-5f);  // still facing the origin
+  EXPECT_NEAR(area_light_area(rect), area, 1e-3 * area);
+  EXPECT_TRUE(resize_light(rect, 2));
+  EXPECT_NEAR(area_light_area(rect), 4 * area, 1e-3 * area);
+  EXPECT_NEAR((area_light_centroid(rect) - Vec3f(80, 0, 0)).norm(), 0.0f, 1e-3f);
+  EXPECT_FALSE(resize_light(rect, 0));
+  Light point = parse_light("point:0,0,50:1,1,1");
+  EXPECT_FALSE(resize_light(point, 2));
 }
 
 }  // namespace

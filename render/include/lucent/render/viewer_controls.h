@@ -36,7 +36,12 @@ struct OrbitView {
 /// Turns a light about the mesh centre (the origin of a loaded mesh) by an azimuth about +y and an
 /// elevation toward +y, both in degrees; elevation stays within +-89 degrees. Directional lights
 /// turn their direction, point lights their position (its distance from the centre is kept).
+/// Area lights turn rigidly with their centroid.
 void drag_light(Light& light, float d_azimuth_deg, float d_elevation_deg);
+
+/// Scales an area light's polygon about its centroid by `scale` (> 0; its radiance is kept, so its
+/// power grows with its area); false (nothing changed) for other lights or a bad scale.
+bool resize_light(Light& light, float scale);
 
 /// The seeds' sine deformer along one axis: every vertex moves along x by
 ///   A sin(2 pi waves (y - y_min) / height + speed t),
