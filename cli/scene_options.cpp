@@ -10,6 +10,7 @@
 #include <numbers>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "lucent/materials/error.h"
@@ -133,6 +134,16 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
                   "reference (area): surface samples per pass (uniform by area)")
       ->check(whole_in(1, 1000000000, "surface samples"))
       ->capture_default_str();
+  cmd->add_option("--area-light-samples", args->reference.area_light_samples,
+                  "reference: points on each area light (shadow rays) per surface point, "
+                  "stratified, with the analytic form factor as control variate")
+      ->check(whole_in(1, 4096, "area light samples"))
+      ->capture_default_str();
+  cmd->add_option("--irradiance-cache", args->irradiance_cache,
+                  "reference (probes): on: area lights' irradiance from per-cluster projection "
+                  "maps (seed 002; bilinear between grid vertices evaluated once) instead of "
+                  "shadow rays at every hit")
+      ->capture_default_str();
   cmd->add_option("--passes", args->reference.passes,
                   "reference: progressive passes, each with new samples (image = their mean)")
       ->check(whole_in(1, 1000000, "passes"))
@@ -185,6 +196,10 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
                   "sh: the attenuation in the thickness: seed (eq. 12 as printed, guarded), "
                   "normalised (eq. 12 scaled to R_tot at d = 0) or slab (eq. 12 integrated over "
                   "the plane, scaled to R_tot at d = 0)")
+      ->capture_default_str();
+  cmd->add_option("--hbe-irradiance-cache", args->hbe_irradiance_cache,
+                  "hierarchical: on: area lights' leaf irradiance from per-cluster projection maps "
+                  "(seed 002) built once; off: 16 shadow rays per leaf every frame")
       ->capture_default_str();
   cmd->add_option("--hbe-mode", args->hbe_mode,
                   "hierarchical: render (links kept), incremental (links repaired within "
@@ -295,6 +310,14 @@ SceneSetup build_scene(SceneArguments& args) {
   if (!(args.roughness >= 0) || !(args.roughness <= 1)) {
     throw Error("--roughness: the GGX width must be 0..1, got " + std::to_string(args.roughness));
   }
+  for (const auto& [name, value] : {std::pair{"--irradiance-cache", &args.irradiance_cache},
+                                    std::pair{"--hbe-irradiance-cache", &args.hbe_irradiance_cache}}) {
+    if (*value != "on" && *value != "off") {
+      throw Error(std::string(name) + ": expected on or off, got '" + *value + "'");
+    }
+  }
+  args.reference.irradiance_cache = args.irradiance_cache == "on";
+  args.hbe.irradiance_cache = args.hbe_irradiance_cache == "on";
   if (args.specular != "on" && args.specular != "off") {
     throw Error("--specular: expected on or off, got '" + args.specular + "'");
   }

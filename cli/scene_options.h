@@ -33,6 +33,8 @@ struct SceneArguments {
   bool auto_exposure = true;      ///< set by build_scene from `exposure`
   float roughness = 0.1f;
   std::string specular = "on";
+  std::string irradiance_cache = "off";  // --irradiance-cache on|off (reference)
+  std::string hbe_irradiance_cache = "on";  // --hbe-irradiance-cache on|off
   std::string backdrop;           ///< R,G,B radiance; empty: black
   int max_blur = -1;              ///< maps: RadianceMapOptions::max_blur_level (-1 automatic)
   std::vector<std::string> default_rig;  ///< set by build_scene: the lights used when none given

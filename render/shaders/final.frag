@@ -16,7 +16,9 @@
 #include "fresnel.glsl"
 #include "environment.glsl"
 #include "specular.glsl"
+#ifdef LUCENT_AREA_LIGHTS
 #include "area_light.glsl"
+#endif
 
 in vec3 f_position;
 in vec3 f_normal;
@@ -77,11 +79,13 @@ vec3 specular_lights(vec3 x_o, vec3 n_o, vec3 w_o) {
   if (!(cos_o > 0.0)) return sum;
   for (int l = 0; l < u_light_count; ++l) {
     vec4 light = u_light_position[l];
+#ifdef LUCENT_AREA_LIGHTS
     if (light.w > 1.5) {
       sum += u_light_radiance[l] *
              area_specular(area_slot(light), x_o, n_o, w_o, u_roughness, u_eta);
       continue;
     }
+#endif
     bool is_point = light.w > 0.5;
     vec3 to_light = is_point ? light.xyz - x_o : light.xyz;
     vec3 w = normalize(to_light);

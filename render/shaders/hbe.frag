@@ -6,7 +6,9 @@
 #include "fresnel.glsl"
 #include "environment.glsl"
 #include "specular.glsl"
+#ifdef LUCENT_AREA_LIGHTS
 #include "area_light.glsl"
+#endif
 
 in vec3 f_position;
 in vec3 f_normal;
@@ -36,10 +38,12 @@ void main() {
   if (u_specular && u_roughness > 0.0 && cos_o > 0.0) {
     for (int l = 0; l < u_light_count; ++l) {
       vec4 p = u_light_position[l];
+#ifdef LUCENT_AREA_LIGHTS
       if (p.w > 1.5) {
         L += u_light_radiance[l] * area_specular(area_slot(p), x_o, n_o, w_o, u_roughness, u_eta);
         continue;
       }
+#endif
       vec3 w = p.xyz;
       vec3 E = u_light_radiance[l];
       if (p.w > 0.5) {

@@ -35,7 +35,9 @@ layout(early_fragment_tests) in;
 #include "bssrdf_ddipole.glsl"
 #include "bssrdf_dipole.glsl"
 #include "bssrdf_tabulated.glsl"
+#ifdef LUCENT_AREA_LIGHTS
 #include "area_light.glsl"
+#endif
 
 in vec3 g_position;  // x_o, mm
 in vec3 g_normal;
@@ -113,7 +115,9 @@ void main() {
   for (int l = 0; l < u_light_count; ++l) {
     vec4 light = u_light_position[l];
     bool is_point = light.w > 0.5;  // point or area (from this frame's point s_t)
+#ifdef LUCENT_AREA_LIGHTS
     bool is_area = light.w > 1.5;
+#endif
     vec3 w_d = is_point ? normalize(light.xyz - x_o) : normalize(light.xyz);
     vec3 t1, t2;
     basis(w_d, t1, t2);
@@ -150,6 +154,7 @@ void main() {
       }
       vec3 w_i;
       vec3 E;
+#ifdef LUCENT_AREA_LIGHTS
       if (is_area) {
         int slot = area_slot(light);
         FormFactor ff = area_form_factor(slot, x_i, n_i);
@@ -162,7 +167,9 @@ void main() {
         vec3 from_disc = light.xyz - x_d;
         E = u_light_radiance[l] * (kPi * ff.F / above) * (d_s * d_s / max(cos_s, 0.15)) *
             max(dot(to_s / d_s, w_d), 0.0) / dot(from_disc, from_disc);
-      } else if (is_point) {
+      } else
+#endif
+      if (is_point) {
         vec3 to_light = light.xyz - x_i;
         w_i = normalize(to_light);
         vec3 from_disc = light.xyz - x_d;

@@ -19,8 +19,17 @@ double radical_inverse(int base, int i) {
 
 }  // namespace
 
-std::string area_light_define() {
-  return "LUCENT_MAX_AREA_LIGHTS " + std::to_string(kMaxAreaLights);
+bool has_area_lights(const std::vector<Light>& lights) {
+  for (const Light& l : lights) {
+    if (l.type == LightType::kArea) return true;
+  }
+  return false;
+}
+
+std::vector<std::string> area_light_defines(const std::vector<Light>& lights) {
+  std::vector<std::string> d = {"LUCENT_MAX_AREA_LIGHTS " + std::to_string(kMaxAreaLights)};
+  if (has_area_lights(lights)) d.push_back("LUCENT_AREA_LIGHTS");
+  return d;
 }
 
 int area_slot(const std::vector<Light>& lights, std::size_t l) {

@@ -13,8 +13,12 @@ namespace lucent::render::gl {
 /// Area lights a GPU technique takes at once (slots of area_light.glsl).
 inline constexpr int kMaxAreaLights = 4;
 
-/// The define every program that includes area_light.glsl needs.
-std::string area_light_define();
+/// The defines every program that includes area_light.glsl needs: the slot count, and
+/// LUCENT_AREA_LIGHTS when `lights` has any (the area branches cost llvmpipe a 3x slower radiance
+/// pass even when no light takes them, so they are compiled only for scenes that use them).
+std::vector<std::string> area_light_defines(const std::vector<Light>& lights);
+
+bool has_area_lights(const std::vector<Light>& lights);
 
 /// Slot of lights[l] among the area lights (0, 1, ... in order), -1 when it is not one. Throws
 /// lucent::Error naming --light when there are more than kMaxAreaLights.

@@ -14,6 +14,7 @@
 #include "lucent/materials/fresnel.h"
 #include "lucent/materials/material.h"
 #include "area_light_irradiance.h"
+#include "irradiance_cache.h"
 #include "reference_common.h"
 
 namespace lucent::render::hbe {
@@ -100,6 +101,7 @@ struct Solver::Impl {
   std::array<Coefficients, 3> c{};
   double eta = 1.3;
   std::unique_ptr<detail::RayScene> rays;
+  std::unique_ptr<detail::IrradianceCache> cache;  // area lights, when o.irradiance_cache
   std::vector<Link> links;
   bool linked = false;
   std::uint64_t material_version = 0, geometry_version = 0;
@@ -112,6 +114,7 @@ struct Solver::Impl {
 
   void set_material(const materials::Material& m) {
     for (int ch = 0; ch < 3; ++ch) c[std::size_t(ch)] = materials::derive_coefficients(m.medium(ch));
+    if (eta != m.ior) cache.reset();  // the cached E_t carries F_t(eta)
     eta = m.ior;
     ++material_version;
   }
@@ -272,6 +275,14 @@ struct Solver::Impl {
     const float eps = 1e-4f * std::max(mesh.bounding_radius(), 1e-6f);
     const std::size_t T = mesh.triangles.size();
     face_E.assign(T, Rgb{});
+    const bool any_area = std::any_of(scene.lights.begin(), scene.lights.end(),
+                                      [](const Light& l) { return l.type == LightType::kArea; });
+    if (any_area && o.irradiance_cache && !cache) {
+      detail::IrradianceCacheOptions co;
+      co.shadow_samples = kAreaLightSamples;
+      co.shadows = o.shadows;
+      cache = std::make_unique<detail::IrradianceCache>(mesh, scene.lights, rays.get(), eta, co);
+    }
     for (std::size_t t = 0; t < T; ++t) {
       const auto& tri = mesh.triangles[t];
       const Vec3f &a = mesh.positions[tri[0]], &b = mesh.positions[tri[1]],
@@ -282,9 +293,14 @@ struct Solver::Impl {
       g.normalize();
       Vec3f n = mesh.normals[tri[0]] + mesh.normals[tri[1]] + mesh.normals[tri[2]];
       n = n.norm() > 0 ? Vec3f(n.normalized()) : g;
+      if (cache) {
+        const auto E = cache->lookup(t, x);
+        for (int ch = 0; ch < 3; ++ch) face_E[t][std::size_t(ch)] += std::max(E[std::size_t(ch)], 0.0);
+      }
       for (std::size_t l = 0; l < scene.lights.size(); ++l) {
         const Light& light = scene.lights[l];
         if (light.type == LightType::kArea) {
+          if (cache) continue;
           // kAreaLightSamples stratified shadow rays with the analytic pi F as control variate
           // (area_light_irradiance.h), the same points every frame (no flicker); a penumbra's
           // rare negative estimate is clamped to 0.
@@ -429,7 +445,10 @@ Solver::Solver(const Scene& scene, const Options& options) : impl_(std::make_uni
 
 Solver::~Solver() = default;
 
-void Solver::set_lights(const std::vector<Light>& lights) { impl_->scene.lights = lights; }
+void Solver::set_lights(const std::vector<Light>& lights) {
+  impl_->scene.lights = lights;
+  impl_->cache.reset();
+}
 
 void Solver::set_material(const materials::Material& material) {
   impl_->scene.material = material;
@@ -446,6 +465,7 @@ void Solver::set_geometry(const std::vector<Vec3f>& positions, const std::vector
   m.scene.mesh.normals = normals;
   m.h.update_geometry(positions);
   m.rays = std::make_unique<detail::RayScene>(m.scene.mesh);
+  m.cache.reset();
   ++m.geometry_version;
 }
 

@@ -102,8 +102,10 @@ void HierarchicalRenderer::setup(const Scene& scene, const hbe::Options& options
   glVertexArrayAttribFormat(vao, 2, 3, GL_FLOAT, GL_FALSE, 0);
   glVertexArrayAttribBinding(vao, 2, 2);
   m.empty_vao = gl::create_vertex_array();
-  const std::vector<std::string> defines = {"LUCENT_MAX_LIGHTS " + std::to_string(kMaxLights),
-                                            gl::area_light_define()};
+  // Area lights' branches always compiled here: hbe.frag is one cheap pass.
+  std::vector<std::string> defines = {"LUCENT_MAX_LIGHTS " + std::to_string(kMaxLights),
+                                      "LUCENT_AREA_LIGHTS"};
+  defines.push_back("LUCENT_MAX_AREA_LIGHTS " + std::to_string(gl::kMaxAreaLights));
   m.program = gl::Program({{GL_VERTEX_SHADER, "hbe.vert"}, {GL_FRAGMENT_SHADER, "hbe.frag"}}, defines);
   m.background_program = gl::Program(
       {{GL_VERTEX_SHADER, "background.vert"}, {GL_FRAGMENT_SHADER, "background.frag"}}, defines);

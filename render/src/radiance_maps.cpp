@@ -129,13 +129,15 @@ void RadianceMapRenderer::Impl::upload_mesh() {
 }
 
 void RadianceMapRenderer::Impl::build_programs() {
-  const std::vector<std::string> defines = {
-      "LUCENT_MAX_LIGHTS " + std::to_string(kMaxLights), gl::area_light_define(),
+  programs_have_area_lights = gl::has_area_lights(scene.lights);
+  std::vector<std::string> defines = {
+      "LUCENT_MAX_LIGHTS " + std::to_string(kMaxLights),
       "LUCENT_MAX_DIRECTIONS " + std::to_string(K),
       "LUCENT_MAX_DISC_SAMPLES " + std::to_string(settings.samples),
       settings.model == DiffusionModel::kDipole      ? "LUCENT_MODEL_DIPOLE"
       : settings.model == DiffusionModel::kTabulated ? "LUCENT_MODEL_TABULATED"
                                                      : "LUCENT_MODEL_DDIPOLE"};
+  for (const std::string& d : gl::area_light_defines(scene.lights)) defines.push_back(d);
   light_map_program = gl::Program({{GL_VERTEX_SHADER, "layered_mesh.vert"},
                                    {GL_GEOMETRY_SHADER, "light_map.geom"},
                                    {GL_FRAGMENT_SHADER, "light_map.frag"}},

@@ -22,7 +22,14 @@ void RadianceMapRenderer::set_lights(const std::vector<Light>& lights) {
   impl_->scene.lights = lights;
   impl_->L = int(lights.size());
   if (resize) impl_->build_light_maps();
-  impl_->upload_lights();
+  if (gl::has_area_lights(lights) != impl_->programs_have_area_lights) {
+    // The programs' area-light branches come and go with the lights (gl_area_lights.h).
+    impl_->build_programs();
+    impl_->upload_layers();
+    impl_->upload_material();  // and the lights
+  } else {
+    impl_->upload_lights();
+  }
   restart();
 }
 

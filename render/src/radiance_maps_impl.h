@@ -101,6 +101,7 @@ struct RadianceMapRenderer::Impl {
   int current = 0;  // ping-pong buffer holding the latest sum
   int level = 0;    // blur level of the last final pass
   bool light_map_valid = false;
+  bool programs_have_area_lights = false;  // compiled with LUCENT_AREA_LIGHTS
   std::vector<float> last_image;
   RadianceMapStats stats;
 

@@ -234,8 +234,12 @@ struct PixelHit {
 
 /// One pass of the probe-ray sampler (reference_probes.cpp): for each object pixel i, the
 /// subsurface radiance before the outgoing Fresnel factor, added to accumulated[i].
+class IrradianceCache;
+
+/// `cache`: area lights' irradiance from it (else shadow rays per hit); may be null.
 void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions& options,
-                const RayScene& rays, const std::vector<PixelHit>& hits,
+                const RayScene& rays, const IrradianceCache* cache,
+                const std::vector<PixelHit>& hits,
                 const std::vector<std::uint32_t>& object_pixels, int pass, int threads,
                 std::vector<std::array<double, 3>>& accumulated, std::uint64_t& probe_hits,
                 const std::function<void(std::size_t)>& on_progress);

@@ -20,6 +20,7 @@
 #include "lucent/materials/fresnel.h"
 #include "profile_sampling.h"
 #include "area_light_irradiance.h"
+#include "irradiance_cache.h"
 #include "reference_common.h"
 
 namespace lucent::render::detail {
@@ -40,7 +41,8 @@ constexpr int kMaxHitsPerProbe = 32;
 }  // namespace
 
 void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions& options,
-                const RayScene& rays, const std::vector<PixelHit>& hits,
+                const RayScene& rays, const IrradianceCache* cache,
+                const std::vector<PixelHit>& hits,
                 const std::vector<std::uint32_t>& object_pixels, int pass, int threads,
                 std::vector<std::array<double, 3>>& accumulated, std::uint64_t& probe_hits,
                 const std::function<void(std::size_t)>& on_progress) {
@@ -143,9 +145,19 @@ void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions
               if (!per_light) {
                 for (int c = 0; c < 3; ++c) radial[c] = bssrdf[c](x_i, n_i, n_i, x_o, n_o);
               }
+              if (cache) {
+                Vec3f w_cache;
+                const auto E = cache->lookup(tri, x_f, &w_cache);
+                const Vec3d w_i = w_cache.cast<double>();
+                for (int c = 0; c < 3; ++c) {
+                  const double s_d = per_light ? bssrdf[c](x_i, n_i, w_i, x_o, n_o) : radial[c];
+                  sum[c] += E[std::size_t(c)] / pdf * s_d;
+                }
+              }
               for (std::size_t l = 0; l < scene.lights.size(); ++l) {
                 const Light& light = scene.lights[l];
                 if (light.type == LightType::kArea) {
+                  if (cache) continue;
                   const AreaIrradiance a = area_light_irradiance(
                       light, x_f, n_f, g_f, &rays, eps, eta, area_sampling,
                       mix(key ^ (0xA2EAull + std::uint64_t(n) * 0x100000001B3ull + l)));

@@ -23,6 +23,7 @@
 #include "lucent/materials/specular.h"
 #include "lucent/render/environment.h"
 #include "area_light_irradiance.h"
+#include "irradiance_cache.h"
 #include "reference_common.h"
 
 namespace lucent::render {
@@ -465,6 +466,16 @@ ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
   const std::size_t N = std::size_t(options.surface_samples);
   const SurfaceSampler sampler(mesh);
   const AreaLightSampling area_sampling = area_light_sampling(options);
+  std::unique_ptr<IrradianceCache> cache;
+  if (options.irradiance_cache &&
+      std::any_of(scene.lights.begin(), scene.lights.end(),
+                  [](const Light& l) { return l.type == LightType::kArea; })) {
+    IrradianceCacheOptions co;
+    co.texel_mm = options.irradiance_cache_texel_mm;
+    co.shadow_samples = options.irradiance_cache_samples;
+    co.shadows = options.shadows;
+    cache = std::make_unique<IrradianceCache>(mesh, scene.lights, &rays, eta, co);
+  }
   const double area_per_sample = sampler.area() / double(N);
 
   ImageRgb mean(W, H, 0.0f);
@@ -482,7 +493,8 @@ ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
       const double work_before = double(pass) * double(std::max<std::size_t>(object_pixels.size(), 1));
       const double work_all =
           double(options.passes) * double(std::max<std::size_t>(object_pixels.size(), 1));
-      probe_pass(scene, model, options, rays, hits, object_pixels, pass, threads, accumulated,
+      probe_pass(scene, model, options, rays, cache.get(), hits, object_pixels, pass, threads,
+                 accumulated,
                  probe_hits, [&](std::size_t done) {
                    if (!options.progress) return;
                    std::lock_guard<std::mutex> lock(progress_mutex);

@@ -60,6 +60,10 @@ struct Options {
   Mode mode = Mode::kRender;
   long budget = 200000;  ///< kIncremental: link factors evaluated per frame (3 channels each)
   bool shadows = true;   ///< shadow rays from the leaves' midpoints toward each light
+  /// Area lights: leaf irradiance from the per-cluster projection maps of seed 002 (built once
+  /// per light set and geometry, looked up every frame; render/src/irradiance_cache.h), texel
+  /// the bounding radius / 64; false: 16 shadow rays per leaf every frame.
+  bool irradiance_cache = true;
 
   void validate() const;  ///< throws lucent::Error naming the option
   std::string to_string() const;
