@@ -1,0 +1,268 @@
+// The fur tile of seed 001 on the CPU (render/include/lucent/render/fur.h).
+#include "lucent/render/fur.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <thread>
+
+#include "lucent/materials/error.h"
+
+namespace lucent::render::fur {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// 12-point Gauss-Legendre on [-1, 1] (nodes and weights, symmetric halves).
+constexpr double kGaussX[6] = {0.1252334085114689, 0.3678314989981802, 0.5873179542866175,
+                               0.7699026741943047, 0.9041172563704749, 0.9815606342467192};
+constexpr double kGaussW[6] = {0.2491470458134028, 0.2334925365383548, 0.2031674267230659,
+                               0.1600783285433462, 0.1069393259953184, 0.0471753363865118};
+
+template <typename F>
+double gauss12(F&& f, double a, double b) {
+  const double h = 0.5 * (b - a), m = 0.5 * (a + b);
+  double sum = 0;
+  for (int i = 0; i < 6; ++i) sum += kGaussW[i] * (f(m - h * kGaussX[i]) + f(m + h * kGaussX[i]));
+  return sum * h;
+}
+
+int wrap(int i, int n) { return ((i % n) + n) % n; }
+
+}  // namespace
+
+void FurOptions::validate() const {
+  if (texels < 2 || texels > 4096) throw Error("--fur-texels: expected 2..4096");
+  if (shells < 1 || shells > 1024) throw Error("--fur-shells: expected 1..1024");
+  if (!(shell_spacing > 0) || !std::isfinite(shell_spacing)) {
+    throw Error("fur: the shell spacing must be positive (texels)");
+  }
+  for (const Coat* c : {&overcoat, &undercoat}) {
+    if (c->hairs < 0 || !(c->width_min >= 0) || !(c->width_max >= c->width_min) ||
+        !(c->length > 0) || !(c->length <= 1)) {
+      throw Error("fur: a coat needs hairs >= 0, 0 <= width_min <= width_max and length in (0, 1]");
+    }
+  }
+  if (!(curl_max >= 0) || !(optical_density >= 0)) {
+    throw Error("fur: curl and optical density must not be negative");
+  }
+  if (coverage == CoverageRule::kSeed && (overcoat.width_max > 1 || undercoat.width_max > 1)) {
+    throw Error("fur: the seed's coverage rule takes hairs at most one texel wide");
+  }
+  if (quadrature_nodes < 3 || quadrature_nodes > 256) throw Error("fur: quadrature nodes 3..256");
+}
+
+std::vector<Hair> generate_hairs(const FurOptions& o) {
+  o.validate();
+  std::mt19937_64 rng(o.seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Hair> hairs;
+  for (const Coat* coat : {&o.overcoat, &o.undercoat}) {
+    for (int k = 0; k < coat->hairs; ++k) {
+      Hair h;
+      h.base = Eigen::Vector2d(u(rng) * o.texels, u(rng) * o.texels);
+      h.width = coat->width_min + (coat->width_max - coat->width_min) * u(rng);
+      h.length = coat->length * o.shells;
+      const double angle = 2 * kPi * u(rng);
+      h.curl = o.curl_max * u(rng) * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+      hairs.push_back(h);
+    }
+  }
+  return hairs;
+}
+
+double disc_square_overlap(const Eigen::Vector2d& c, double r, double x0, double y0) {
+  if (!(r > 0)) return 0;
+  const double x1 = x0 + 1, y1 = y0 + 1;
+  // x = c.x + r sin(theta), half-chord r cos(theta), dx = r cos(theta) d theta.
+  const auto angle_of = [&](double x) { return std::asin(std::clamp((x - c.x()) / r, -1.0, 1.0)); };
+  const double a = angle_of(x0), b = angle_of(x1);
+  if (!(b > a)) return 0;
+  std::vector<double> cuts = {a, b};
+  for (double y : {y0, y1}) {
+    const double d = std::abs(y - c.y());
+    if (d < r) {
+      const double t = std::acos(d / r);
+      for (double s : {-t, t})
+        if (s > a && s < b) cuts.push_back(s);
+    }
+  }
+  std::sort(cuts.begin(), cuts.end());
+  const auto integrand = [&](double theta) {
+    const double h = r * std::cos(theta);
+    const double length = std::min(c.y() + h, y1) - std::max(c.y() - h, y0);
+    return std::max(length, 0.0) * r * std::cos(theta);
+  };
+  double area = 0;
+  for (std::size_t i = 0; i + 1 < cuts.size(); ++i) area += gauss12(integrand, cuts[i], cuts[i + 1]);
+  return area;
+}
+
+std::array<double, 4> seed_coverage(const Eigen::Vector2d& c, double r) {
+  std::array<double, 4> out{0, 0, 0, 0};
+  const double circle = kPi * r * r;
+  const double i1 = std::floor(c.x() - r) + 1, j1 = std::floor(c.y() - r) + 1;
+  // Penetrations past the texel's right and lower (next-y) edges.
+  const double dx = c.x() + r - i1, dy = c.y() + r - j1;
+  // Eq. 1 (Harris and Stocker): a segment of depth d, m = sqrt(d (2r - d)); it approximates the
+  // minor segment, so a segment deeper than r is the disc less its complement.
+  const auto minor = [&](double d) {
+    const double m = std::sqrt(d * (2 * r - d));
+    return m > 0 ? 4.0 / 3.0 * d * m + d * d * d / (4 * m) : 0.0;
+  };
+  const auto chord = [&](double d) {
+    if (!(d > 0)) return 0.0;
+    if (d >= 2 * r) return circle;
+    return d <= r ? minor(d) : circle - minor(2 * r - d);
+  };
+  const double right = chord(dx), lower = chord(dy);
+  if (right == 0 && lower == 0) {  // case 1
+    out[0] = circle;
+    return out;
+  }
+  if (lower == 0) {  // case 2, across the right edge
+    out[0] = circle - right;
+    out[1] = right;
+    return out;
+  }
+  if (right == 0) {  // case 2, across the lower edge
+    out[0] = circle - lower;
+    out[2] = lower;
+    return out;
+  }
+  // Case 3: the corner. Eq. 2: a quarter disc of the mean of the wedge's two sides.
+  const double s1 = std::max(0.0, c.y() + std::sqrt(std::max(0.0, r * r - (i1 - c.x()) * (i1 - c.x()))) - j1);
+  const double s2 = std::max(0.0, c.x() + std::sqrt(std::max(0.0, r * r - (j1 - c.y()) * (j1 - c.y()))) - i1);
+  const double wedge = 0.25 * kPi * 0.25 * (s1 + s2) * (s1 + s2);
+  out[0] = circle - (right + lower - wedge);
+  out[1] = right - wedge;
+  out[2] = lower - wedge;
+  out[3] = wedge;
+  return out;
+}
+
+FurTile rasterize_hairs(const std::vector<Hair>& hairs, const FurOptions& o) {
+  o.validate();
+  FurTile tile;
+  tile.texels = o.texels;
+  tile.shells = o.shells;
+  tile.shell_spacing = o.shell_spacing;
+  tile.density.assign(std::size_t(o.shells) * o.texels * o.texels, 0.0f);
+  const int n = o.texels;
+  for (const Hair& hair : hairs) {
+    for (int s = 0; s < o.shells; ++s) {
+      const double z = s + 0.5;  // the shell's height, shells
+      if (z >= hair.length) break;
+      const double t = z / hair.length;
+      const double r = 0.5 * hair.width * (1 - t);
+      const Eigen::Vector2d centre = hair.base + t * t * hair.curl;
+      if (o.coverage == CoverageRule::kSeed) {
+        const auto f = seed_coverage(centre, r);
+        const int i = int(std::floor(centre.x() - r)), j = int(std::floor(centre.y() - r));
+        const int di[4] = {0, 1, 0, 1}, dj[4] = {0, 0, 1, 1};
+        for (int k = 0; k < 4; ++k) {
+          if (f[std::size_t(k)] != 0) {
+            tile.at(s, wrap(j + dj[k], n), wrap(i + di[k], n)) += float(f[std::size_t(k)]);
+          }
+        }
+        continue;
+      }
+      const int i0 = int(std::floor(centre.x() - r)), i1 = int(std::floor(centre.x() + r));
+      const int j0 = int(std::floor(centre.y() - r)), j1 = int(std::floor(centre.y() + r));
+      for (int j = j0; j <= j1; ++j) {
+        for (int i = i0; i <= i1; ++i) {
+          const double a = disc_square_overlap(centre, r, i, j);
+          if (a > 0) tile.at(s, wrap(j, n), wrap(i, n)) += float(a);
+        }
+      }
+    }
+  }
+  for (float& d : tile.density) d = std::clamp(d, 0.0f, 1.0f);
+  return tile;
+}
+
+double transmittance(const FurTile& tile, int s, int y, int x, const Eigen::Vector3d& d,
+                     double optical_density) {
+  if (!(d.z() > 0)) return 0;  // into the skin
+  const int n = tile.texels;
+  const double top = tile.shells * tile.shell_spacing;
+  const Eigen::Vector3d p(x + 0.5, y + 0.5, (s + 0.5) * tile.shell_spacing);
+  const double length = (top - p.z()) / d.z();
+  const int steps = std::max(1, int(std::ceil(length / 0.5)));
+  const double dt = length / steps;
+  const auto density = [&](const Eigen::Vector3d& q) {
+    // Trilinear between voxel centres, periodic in x and y, clamped in z.
+    const double u = q.x() - 0.5, v = q.y() - 0.5, w = std::clamp(q.z() / tile.shell_spacing - 0.5, 0.0, tile.shells - 1.0);
+    const int iu = int(std::floor(u)), iv = int(std::floor(v)), iw = std::min(int(std::floor(w)), tile.shells - 1);
+    const double fu = u - iu, fv = v - iv, fw = w - iw;
+    const int iw1 = std::min(iw + 1, tile.shells - 1);
+    double sum = 0;
+    for (int k = 0; k < 8; ++k) {
+      const int a = k & 1, b = (k >> 1) & 1, c = (k >> 2) & 1;
+      const double weight = (a ? fu : 1 - fu) * (b ? fv : 1 - fv) * (c ? fw : 1 - fw);
+      if (weight == 0) continue;
+      sum += weight * tile.at(c ? iw1 : iw, wrap(iv + b, n), wrap(iu + a, n));
+    }
+    return sum;
+  };
+  double tau = 0;
+  for (int k = 0; k < steps; ++k) {
+    tau += optical_density * density(p + (k + 0.5) * dt * d) * dt;
+    if (tau > 40) return 0;  // T < 4e-18
+  }
+  return std::exp(-tau);
+}
+
+void compute_transfer(FurTile& tile, const FurOptions& o, int threads) {
+  const ShQuadrature rule = sh_quadrature(o.quadrature_nodes);
+  std::vector<ShVector<double>> Y;
+  std::vector<std::size_t> upper;
+  for (std::size_t k = 0; k < rule.directions.size(); ++k) {
+    Y.push_back(sh_basis<double>(rule.directions[k]));
+    if (rule.directions[k].z() > 0) upper.push_back(k);
+  }
+  const int n = tile.texels;
+  tile.transfer.assign(tile.density.size() * kShCoefficients, 0.0f);
+  if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+  std::atomic<int> next{0};
+  const auto work = [&] {
+    for (int s; (s = next.fetch_add(1)) < tile.shells;) {
+      for (int y = 0; y < n; ++y) {
+        for (int x = 0; x < n; ++x) {
+          ShVector<double> t{};
+          for (std::size_t k : upper) {
+            const double T = rule.weights[k] * transmittance(tile, s, y, x, rule.directions[k],
+                                                             o.optical_density);
+            if (T == 0) continue;
+            for (int i = 0; i < kShCoefficients; ++i) t[std::size_t(i)] += T * Y[k][std::size_t(i)];
+          }
+          float* out = &tile.transfer[((std::size_t(s) * n + y) * n + x) * kShCoefficients];
+          for (int i = 0; i < kShCoefficients; ++i) out[i] = float(t[std::size_t(i)]);
+        }
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+}
+
+FurTile make_fur_tile(const FurOptions& options, int threads) {
+  FurTile tile = rasterize_hairs(generate_hairs(options), options);
+  compute_transfer(tile, options, threads);
+  return tile;
+}
+
+double shade(const FurTile& tile, int s, int y, int x, const ShVector<double>& light) {
+  const float* t =
+      &tile.transfer[((std::size_t(s) * tile.texels + y) * tile.texels + x) * kShCoefficients];
+  double sum = 0;
+  for (int i = 0; i < kShCoefficients; ++i) sum += light[std::size_t(i)] * t[i];
+  return sum;
+}
+
+}  // namespace lucent::render::fur
