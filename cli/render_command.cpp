@@ -17,6 +17,7 @@
 #include "lucent/materials/json_file.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
+#include "lucent/render/fur_renderer.h"
 #include "lucent/render/hierarchical_renderer.h"
 #include "lucent/render/radiance_maps.h"
 #include "lucent/render/reference_renderer.h"
@@ -78,6 +79,8 @@ void run_render(RenderArguments& render_args) {
     image = render_sh(scene, args.sh, &stats);
   } else if (args.technique == "hierarchical") {
     image = render_hierarchical(scene, args.hbe, &stats);
+  } else if (args.technique == "fur") {
+    image = render_fur(scene, args.fur, &stats);
   } else {
     RadianceMapOptions options;
     options.max_blur_level = args.max_blur;
@@ -137,6 +140,7 @@ void run_render(RenderArguments& render_args) {
               args.technique == "maps" ? "radiance maps"
               : args.technique == "sh"           ? "SH fast translucency"
               : args.technique == "hierarchical" ? "hierarchical boundary elements"
+              : args.technique == "fur"          ? "fur shells with SH transfer"
                                                  : "CPU reference",
               materials::to_string(args.settings.model).c_str(), scene.mesh.name.c_str(),
               png ? "exposure " : "linear",

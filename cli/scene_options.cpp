@@ -89,8 +89,8 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
                   "maps (real-time radiance maps, OpenGL), sh (spherical-harmonics fast "
                   "translucency, OpenGL, seed 000: not physically based), hierarchical "
                   "(boundary elements on a face-cluster hierarchy, seed 004: the standard dipole, "
-                  "solved on the CPU, shaded per vertex on the GPU) or reference (CPU, slow, exact "
-                  "up to sampling noise)")
+                  "solved on the CPU, shaded per vertex on the GPU), fur (seed 001: shells with SH "
+                  "transfer, --mesh tile) or reference (CPU, slow, exact up to sampling noise)")
       ->capture_default_str();
   cmd->add_option("--model", args->model,
                   "tabulated (exact to Monte Carlo transport), ddipole (directional dipole) or "
@@ -197,6 +197,14 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
                   "normalised (eq. 12 scaled to R_tot at d = 0) or slab (eq. 12 integrated over "
                   "the plane, scaled to R_tot at d = 0)")
       ->capture_default_str();
+  cmd->add_option("--fur-texels", args->fur.texels, "fur: the tile's texels across (seed: 64)")
+      ->check(whole_in(2, 4096, "fur texels"))
+      ->capture_default_str();
+  cmd->add_option("--fur-shells", args->fur.shells, "fur: shells (seed: 32)")
+      ->check(whole_in(1, 1024, "fur shells"))
+      ->capture_default_str();
+  cmd->add_option("--fur-seed", args->fur.seed, "fur: the hair generator's seed")
+      ->capture_default_str();
   cmd->add_option("--hbe-irradiance-cache", args->hbe_irradiance_cache,
                   "hierarchical: on: area lights' leaf irradiance from per-cluster projection maps "
                   "(seed 002) built once; off: 16 shadow rays per leaf every frame")
@@ -261,8 +269,8 @@ SceneSetup build_scene(SceneArguments& args) {
                 "in (0, 1e4] bounding radii, got '" + args.view + "'");
   }
   if (args.technique != "maps" && args.technique != "sh" && args.technique != "hierarchical" &&
-      args.technique != "reference") {
-    throw Error("--technique: expected maps, sh, hierarchical or reference, got '" +
+      args.technique != "fur" && args.technique != "reference") {
+    throw Error("--technique: expected maps, sh, hierarchical, fur or reference, got '" +
                 args.technique + "'");
   }
   args.hbe.mode = render::hbe::parse_mode(args.hbe_mode);
@@ -317,6 +325,16 @@ SceneSetup build_scene(SceneArguments& args) {
     }
   }
   args.reference.irradiance_cache = args.irradiance_cache == "on";
+  if (args.technique == "fur") {
+    // Hair counts follow the tile's area (the seed's density at 64 x 64 texels).
+    const double scale = double(args.fur.texels) * args.fur.texels / (64.0 * 64.0);
+    args.fur.overcoat.hairs = int(std::lround(600 * scale));
+    args.fur.undercoat.hairs = int(std::lround(2400 * scale));
+    args.fur.validate();
+    if (args.mesh != "tile") {
+      throw Error("--technique fur: renders seed 001's flat fur tile: use --mesh tile");
+    }
+  }
   args.hbe.irradiance_cache = args.hbe_irradiance_cache == "on";
   if (args.specular != "on" && args.specular != "off") {
     throw Error("--specular: expected on or off, got '" + args.specular + "'");

@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "lucent/render/reference_renderer.h"
+#include "lucent/render/fur.h"
 #include "lucent/render/hierarchical.h"
 #include "lucent/render/render_settings.h"
 #include "lucent/render/scene.h"
@@ -44,6 +45,7 @@ struct SceneArguments {
   std::string sh_fresnel = "exact";  ///< exact | schlick
   std::string sh_attenuation = "slab";  ///< seed | normalised | slab
   render::hbe::Options hbe;        ///< --technique hierarchical: oracle, form factor, mode
+  render::fur::FurOptions fur;     ///< --technique fur: the tile
   std::string hbe_mode = "render", hbe_rule = "gauss2", hbe_dipole = "chord";
 };
 

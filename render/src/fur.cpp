@@ -191,7 +191,7 @@ double transmittance(const FurTile& tile, int s, int y, int x, const Eigen::Vect
   const double top = tile.shells * tile.shell_spacing;
   const Eigen::Vector3d p(x + 0.5, y + 0.5, (s + 0.5) * tile.shell_spacing);
   const double length = (top - p.z()) / d.z();
-  const int steps = std::max(1, int(std::ceil(length / 0.5)));
+  const int steps = std::max(1, int(std::ceil(length)));  // one texel per step
   const double dt = length / steps;
   const auto density = [&](const Eigen::Vector3d& q) {
     // Trilinear between voxel centres, periodic in x and y, clamped in z.

@@ -33,7 +33,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr const char* kBuiltIns = "sphere, bunny, dragon:1, dragon:2, dragon:3, dragon:4";
+constexpr const char* kBuiltIns = "sphere, bunny, dragon:1, dragon:2, dragon:3, dragon:4, tile";
 
 std::string read_file(const fs::path& path, const std::string& what) {
   std::ifstream in(path, std::ios::binary);
@@ -311,6 +311,16 @@ Mesh load_mesh(const std::string& name_or_path, double object_size_mm) {
     }
     mesh = make_icosphere(level[0] - '0');
     exact_normals = true;
+  } else if (name_or_path == "tile") {
+    // Seed 001's fur tile: the volume of its shells, a box as wide as deep and half as high
+    // (64 x 64 texels x 32 shells at one texel per shell), skin at y = 0.
+    const auto corner = [](int i) {
+      return Vec3f((i & 1) ? 0.5f : -0.5f, (i & 2) ? 0.5f : 0.0f, (i & 4) ? 0.5f : -0.5f);
+    };
+    for (int i = 0; i < 8; ++i) mesh.positions.push_back(corner(i));
+    mesh.triangles = {{0, 1, 5}, {0, 5, 4}, {2, 6, 7}, {2, 7, 3}, {0, 2, 3}, {0, 3, 1},
+                      {4, 5, 7}, {4, 7, 6}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+    mesh.name = "tile";
   } else if (name_or_path == "bunny") {
     mesh = load_bunny();
   } else if (name_or_path.rfind("dragon:", 0) == 0) {

@@ -13,6 +13,9 @@ lucent_add_test(slab_truth_test
 lucent_add_test(sh_renderer_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/sh_renderer_test.cpp
   LIBS lucent::render lucent::materials OpenGL::OpenGL)
+lucent_add_test(fur_renderer_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/fur_renderer_test.cpp
+  LIBS lucent::render lucent::materials OpenGL::OpenGL)
 lucent_add_test(area_light_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/area_light_test.cpp
   LIBS lucent::render lucent::materials OpenGL::OpenGL)

@@ -16,7 +16,7 @@
 //   texel wide; measured in tests/render/fur_test.cpp: the chord within 0.8% (taken as the minor
 //   segment), the wedge exact on the corner and 13-32% off once the disc moves off it). Coverage adds up and is clamped to 1 per texel; the tile wraps.
 // - Transmittance (eq. 4): T(p, d) = exp(-r sum rho(p + t d) dt), marched from the voxel centre p
-//   in half-voxel steps with trilinear density (periodic in x, y) until the top of the volume;
+//   in one-texel steps (midpoint rule) with trilinear density (periodic in x, y) until the top of the volume;
 //   directions into the skin (d_z <= 0) are blocked (T = 0). r: `optical_density` per texel of
 //   fully covered path.
 // - Transfer: t_i(p) = integral T(p, w) Y_i(w) dw by an exact product quadrature on the sphere
@@ -53,7 +53,9 @@ struct FurOptions {
   double curl_max = 3.0;        ///< texels of lateral offset at a hair's tip
   double optical_density = 1.5;  ///< r of eq. 4 per texel of fully covered path
   CoverageRule coverage = CoverageRule::kExact;
-  int quadrature_nodes = 12;     ///< Gauss nodes in cos theta (x 2 n azimuths) for the transfer
+  /// Gauss nodes in cos theta (x 2 n azimuths; the upper half used) for the transfer: 8 integrate
+  /// a lobe light's relighting within 1.4% of a 32-node rule (tests/render/fur_test.cpp).
+  int quadrature_nodes = 8;
   std::uint64_t seed = 1;
 
   void validate() const;  ///< throws lucent::Error naming the option

@@ -1,0 +1,52 @@
+// `--technique fur --mesh tile` (seed 001, Klotzli and Olano) on OpenGL 4.5: the fur tile of fur.h
+// (hairs, cross-sections, transfer precomputed on the CPU at setup) drawn as stacked shells, the
+// lights projected onto the 25 real SH each frame and the per-fragment 25-term dot product with the
+// shell's transfer (7 RGBA layers per shell), shells alpha-blended back to front over the skin.
+//
+// Shading: the light reaching a voxel, integral L(w) T(w) dw = sum_i c_i t_i (the seed's lighting
+// model: no hair BRDF), scattered isotropically by hairs of the material's reduced albedo:
+// L_out = albedo / (4 pi) sum_i c_i t_i, clamped at 0 (the SH of a point or directional light
+// rings). The skin under the fur: albedo / pi times the bottom shell's sum (the light reaching it).
+#pragma once
+
+#include <memory>
+
+#include "lucent/render/fur.h"
+#include "lucent/render/render_settings.h"
+#include "lucent/render/scene.h"
+
+namespace lucent::render {
+
+/// The SH coefficients (per channel) of the lights as seen from `centre` (mm), in the tile's frame
+/// (tile z = world +y, tile x = world +x, tile y = world -z): a directional light E Y_i(d), a point
+/// light I / r^2 Y_i(w), an area light by 64 stratified points L cos_p dA / r^2 Y_i(w).
+std::array<ShVector<double>, 3> fur_light_sh(const std::vector<Light>& lights, const Vec3f& centre);
+
+/// The world direction of a tile-frame direction and back.
+Eigen::Vector3d tile_from_world(const Eigen::Vector3d& w);
+
+class FurRenderer {
+ public:
+  FurRenderer();
+  ~FurRenderer();
+  FurRenderer(const FurRenderer&) = delete;
+  FurRenderer& operator=(const FurRenderer&) = delete;
+
+  /// Builds the tile (CPU, threads) and the GL objects; the scene's mesh must be `tile`.
+  void setup(const Scene& scene, const fur::FurOptions& options);
+  void set_camera(const Camera& camera);  ///< same size as at setup
+  void set_lights(const std::vector<Light>& lights);
+  void render_frame();
+  ImageRgb read_image() const;
+  double precompute_ms() const;  ///< the tile's hairs, cross-sections and transfer
+  double draw_ms() const;        ///< the last frame (glFinish + wall clock)
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// One frame in a headless context (stats: technique "fur", precompute and draw times).
+ImageRgb render_fur(const Scene& scene, const fur::FurOptions& options, RenderStats* stats = nullptr);
+
+}  // namespace lucent::render
