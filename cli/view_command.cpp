@@ -49,6 +49,7 @@ void run_view(ViewArguments& args) {
   options.technique = args.scene.technique;
   options.sh = args.scene.sh;
   options.hbe = args.scene.hbe;
+  options.fur = args.scene.fur;
   options.deform_amplitude = args.deform;
   options.script = args.script;
   options.hide_panel = args.hide_panel;
@@ -82,7 +83,7 @@ void register_view_command(CLI::App& app) {
       "the difference of the current technique (maps, or sh after its best scale) against the last "
       "CPU reference of the same view, Esc quits. The panel "
       "(scaled to the window) switches the material (library or file, reloaded when the file "
-      "changes), technique (maps, sh, hierarchical, reference) and model, edits the material (per channel mean free path and albedo, "
+      "changes), technique (maps, sh, hierarchical, fur on --mesh tile with L for the seed's rotating lobe light, reference) and model, edits the material (per channel mean free path and albedo, "
       "eta, g), and has sliders for N, M, q, K, W_s, W_l, T, exposure, object size and the "
       "deformer.");
   // The reference in the window runs pass after pass at half the window's resolution: fewer

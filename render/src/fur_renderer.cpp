@@ -73,8 +73,10 @@ struct FurRenderer::Impl {
   gl::Sampler sampler;
   double precompute_ms = 0, draw_ms = 0;
 
-  void upload_lights() {
-    const auto c = fur_light_sh(scene.lights, Vec3f(0, 0, 0));
+  gl::Program present_program;
+
+  void upload_lights() { upload_sh(fur_light_sh(scene.lights, Vec3f(0, 0, 0))); }
+  void upload_sh(const std::array<ShVector<double>, 3>& c) {
     const char* names[3] = {"u_light_r", "u_light_g", "u_light_b"};
     for (int ch = 0; ch < 3; ++ch) {
       float packed[28] = {};
@@ -139,6 +141,8 @@ void FurRenderer::setup(const Scene& scene, const fur::FurOptions& options) {
   m.program = gl::Program({{GL_VERTEX_SHADER, "fur.vert"}, {GL_FRAGMENT_SHADER, "fur.frag"}});
   m.background_program = gl::Program(
       {{GL_VERTEX_SHADER, "background.vert"}, {GL_FRAGMENT_SHADER, "background.frag"}});
+  m.present_program = gl::Program(
+      {{GL_VERTEX_SHADER, "background.vert"}, {GL_FRAGMENT_SHADER, "present.frag"}});
   glProgramUniform1i(m.program.id(), m.program.location("u_transfer"), 0);
   m.color = gl::create_texture(GL_TEXTURE_2D);
   glTextureStorage2D(m.color.id(), 1, GL_RGBA32F, m.width, m.height);
@@ -170,6 +174,16 @@ void FurRenderer::set_camera(const Camera& camera) {
 void FurRenderer::set_lights(const std::vector<Light>& lights) {
   impl_->scene.lights = lights;
   impl_->upload_lights();
+}
+
+void FurRenderer::set_light_sh(const std::array<ShVector<double>, 3>& light) {
+  impl_->upload_sh(light);
+}
+
+void FurRenderer::present(float exposure, int width, int height) const {
+  const Impl& m = *impl_;
+  gl::draw_present(m.present_program, m.color.id(), m.sampler.id(), m.vao.id(), exposure, width,
+                   height);
 }
 
 void FurRenderer::render_frame() {

@@ -83,7 +83,8 @@ int Viewer::run() {
     // input, a finished reference pass (the worker needs the CPU more than the window does) and,
     // now and then, to watch the material file.
     const bool accumulating = (technique_ == "maps" && maps_ && (deformer_ || !maps_->converged())) ||
-                              ((technique_ == "sh" || technique_ == "hierarchical") && deformer_);
+                              ((technique_ == "sh" || technique_ == "hierarchical") && deformer_) ||
+                              (technique_ == "fur" && fur_lobe_);
     if (accumulating) {
       glfwPollEvents();
     } else {
@@ -153,6 +154,8 @@ void Viewer::frame() {
       draw_sh();
     } else if (technique_ == "hierarchical") {
       draw_hierarchical();
+    } else if (technique_ == "fur") {
+      draw_fur();
     } else {
       draw_reference();
     }
@@ -177,6 +180,7 @@ void Viewer::run_script_step() {
     const bool done = technique_ == "maps" ? (maps_ && maps_->converged())
                       : technique_ == "sh" ? (sh_ && sh_->stats().frames > 0)
                       : technique_ == "hierarchical" ? hbe_frames_ > 0
+                      : technique_ == "fur"          ? fur_frames_ > 0
                                            : reference_passes_ > 0;
     if (!done && now < settle_deadline_) return;
     if (!done) std::fprintf(stderr, "view: settle: still not done after %g s\n", kSettleTimeout);
@@ -229,6 +233,7 @@ void Viewer::handle_keys() {
     if (key == GLFW_KEY_H) show_ui_ = !show_ui_;
     if (key == GLFW_KEY_D) show_difference_ = !show_difference_;
     if (key == GLFW_KEY_R) scene_changed();
+    if (key == GLFW_KEY_L) fur_lobe_ = !fur_lobe_;  // fur: the seed's rotating lobe light
     if (key == GLFW_KEY_LEFT_BRACKET) scale_selected_light(1 / 1.25f);  // an area light's size
     if (key == GLFW_KEY_RIGHT_BRACKET) scale_selected_light(1.25f);
     if (key == GLFW_KEY_S) screenshot_path_ = next_screenshot_path();  // taken after drawing

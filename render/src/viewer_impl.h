@@ -32,6 +32,7 @@
 #include "lucent/materials/material.h"
 #include "lucent/materials/profile_table.h"
 #include "lucent/render/radiance_maps.h"
+#include "lucent/render/fur_renderer.h"
 #include "lucent/render/hierarchical_renderer.h"
 #include "lucent/render/sh_renderer.h"
 #include "lucent/render/tone_map.h"
@@ -235,7 +236,8 @@ class Viewer {
   void run_script_step();
   void draw_ui();
   void draw_reference();
-  void draw_hierarchical();  // the same for the hierarchical technique (its solve on the CPU)
+  void draw_hierarchical();
+  void draw_fur();  // seed 001's tile: the scene's lights or the rotating lobe (key L)  // the same for the hierarchical technique (its solve on the CPU)
   void draw_sh();        // sync the scene into the sh renderer, one frame, present
   void draw_technique_frame(const std::function<void()>& frame,
                             const std::function<ImageRgb()>& image,
@@ -279,6 +281,10 @@ class Viewer {
   std::unique_ptr<HierarchicalRenderer> hbe_;
   FrameTarget hbe_target_;
   long hbe_frames_ = 0;
+  std::unique_ptr<FurRenderer> fur_;
+  FrameTarget fur_target_;
+  long fur_frames_ = 0;
+  bool fur_lobe_ = false;  // the seed's rotating lobe light instead of the scene's lights
   std::string material_version_seen_;  // the material the hierarchical solver has
   std::uint64_t geometry_version_ = 0;
   std::unique_ptr<ReferenceWorker> reference_;

@@ -40,7 +40,11 @@ void Viewer::draw_ui() {
   if (ImGui::Button("load")) load_material(material_path_.data());
 
   // Technique and model.
-  int technique = technique_ == "maps" ? 0 : technique_ == "sh" ? 1 : technique_ == "hierarchical" ? 3 : 2;
+  int technique = technique_ == "maps"           ? 0
+                  : technique_ == "sh"           ? 1
+                  : technique_ == "hierarchical" ? 3
+                  : technique_ == "fur"          ? 4
+                                                 : 2;
   if (ImGui::RadioButton("radiance maps", &technique, 0)) set_technique("maps");
   ImGui::SameLine();
   if (ImGui::RadioButton("SH fast", &technique, 1)) set_technique("sh");
@@ -48,6 +52,11 @@ void Viewer::draw_ui() {
   if (ImGui::RadioButton("hierarchical", &technique, 3)) set_technique("hierarchical");
   ImGui::SameLine();
   if (ImGui::RadioButton("CPU reference", &technique, 2)) set_technique("reference");
+  if (scene_.mesh.name == "tile") {
+    ImGui::SameLine();
+    if (ImGui::RadioButton("fur", &technique, 4)) set_technique("fur");
+    if (technique_ == "fur") ImGui::Checkbox("rotating lobe light (L)", &fur_lobe_);
+  }
   int model = settings_.model == DiffusionModel::kDirectionalDipole ? 0
               : settings_.model == DiffusionModel::kDipole          ? 1
                                                                     : 2;

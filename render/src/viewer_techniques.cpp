@@ -6,8 +6,9 @@ namespace lucent::render::viewer_detail {
 
 void Viewer::set_technique(const std::string& technique) {
   if (technique != "maps" && technique != "sh" && technique != "hierarchical" &&
-      technique != "reference") {
-    throw Error("technique: expected maps, sh, hierarchical or reference, got '" + technique + "'");
+      technique != "fur" && technique != "reference") {
+    throw Error("technique: expected maps, sh, hierarchical, fur or reference, got '" + technique +
+                "'");
   }
   technique_ = technique;
   // Same scene, another technique: the cached reference stays valid for the difference view.
@@ -107,9 +108,32 @@ void Viewer::draw_hierarchical() {
       [&] { hbe_->present(settings_.exposure, width_, height_); });
 }
 
+// Seed 001's tile: its transfer is built once (and on a new window size); the light each frame:
+// the scene's, or the seed's single low-frequency lobe turning about the vertical (key L).
+void Viewer::draw_fur() {
+  draw_technique_frame(
+      [&] {
+        keep_current(fur_, fur_target_, scene_, options_.fur, geometry_version_);
+        fur_->set_camera(scene_.camera);
+        if (fur_lobe_) {
+          const double t = glfwGetTime();
+          const Eigen::Vector3d world(std::cos(0.8 * t) * 0.7, 0.7, std::sin(0.8 * t) * 0.7);
+          const ShVector<double> lobe = sh_lobe(tile_from_world(world.normalized()), 4);
+          fur_->set_light_sh({lobe, lobe, lobe});
+        } else {
+          fur_->set_lights(scene_.lights);
+        }
+        fur_->render_frame();
+        ++fur_frames_;
+      },
+      [&] { return fur_->read_image(); },
+      [&] { fur_->present(settings_.exposure, width_, height_); });
+}
+
 ImageRgb Viewer::technique_image() const {
   if (technique_ == "sh" && sh_) return sh_->read_image();
   if (technique_ == "hierarchical" && hbe_) return hbe_->read_image();
+  if (technique_ == "fur" && fur_) return fur_->read_image();
   return maps_->read_image();
 }
 

@@ -9,7 +9,9 @@
 // rings). The skin under the fur: albedo / pi times the bottom shell's sum (the light reaching it).
 #pragma once
 
+#include <array>
 #include <memory>
+#include <vector>
 
 #include "lucent/render/fur.h"
 #include "lucent/render/render_settings.h"
@@ -36,6 +38,11 @@ class FurRenderer {
   void setup(const Scene& scene, const fur::FurOptions& options);
   void set_camera(const Camera& camera);  ///< same size as at setup
   void set_lights(const std::vector<Light>& lights);
+  /// The light as SH coefficients per channel in the tile's frame (the viewer's rotating lobe).
+  void set_light_sh(const std::array<ShVector<double>, 3>& light);
+  /// The tile has no mesh to deform: ignored (the viewer's deformer moves other techniques).
+  void set_geometry(const std::vector<Vec3f>&, const std::vector<Vec3f>&) {}
+  void present(float exposure, int width, int height) const;
   void render_frame();
   ImageRgb read_image() const;
   double precompute_ms() const;  ///< the tile's hairs, cross-sections and transfer

@@ -17,6 +17,7 @@
 #include "lucent/render/reference_renderer.h"
 #include "lucent/render/render_settings.h"
 #include "lucent/render/scene.h"
+#include "lucent/render/fur.h"
 #include "lucent/render/hierarchical.h"
 #include "lucent/render/sh_renderer.h"
 #include "lucent/render/viewer_controls.h"
@@ -34,6 +35,7 @@ struct ViewerOptions {
   std::string technique = "maps";  ///< maps | sh | hierarchical | reference
   hbe::Options hbe;                ///< --technique hierarchical: oracle, form factor, mode
   ShOptions sh;                    ///< --technique sh: shadow map, cube map, depth blur, Fresnel
+  fur::FurOptions fur;             ///< --technique fur: the tile (--mesh tile)
   float deform_amplitude = 0;      ///< sine deformer: fraction of the diagonal; 0 = off
   /// Actions, one per frame, separated by ';' (tests and demos drive the window with them):
   ///   orbit DX DY | light DX DY   mouse drags in pixels (left button / right button)
