@@ -234,6 +234,11 @@ struct PixelHit {
 
 /// One pass of the probe-ray sampler (reference_probes.cpp): for each object pixel i, the
 /// subsurface radiance before the outgoing Fresnel factor, added to accumulated[i].
+/// Every light's specular lobe at a pixel's point, with shadow rays (reference_specular.cpp);
+/// `key`: the random stream for area lights' points.
+Vec3f specular_radiance(const Scene& scene, const RayScene& rays, const PixelHit& hit, float eps,
+                        std::uint64_t key);
+
 class IrradianceCache;
 
 /// `cache`: area lights' irradiance from it (else shadow rays per hit); may be null.
