@@ -77,8 +77,9 @@ namespace {
 using Coefficients = materials::DiffusionCoefficients<double>;
 using Rgb = std::array<double, 3>;
 using Clock = std::chrono::steady_clock;
-// Shadow rays per face for an area light (area_light_irradiance.h): 16 keep a 100 mm sphere under
-// a 40 mm rect within 1% of 256 rays outside the penumbra (the control variate does most of it).
+// Shadow rays per face (or per cache grid vertex) for an area light (area_light_irradiance.h):
+// with the control variate only faces whose horizon cuts the light are noisy; on a 100 mm sphere
+// under a 50 mm rect the cache and per-leaf rays agree to 0.5% in E, 0.3% in B (hbe_solver_test).
 constexpr int kAreaLightSamples = 16;
 
 double ms_since(Clock::time_point t) {
