@@ -80,7 +80,7 @@ void run_render(RenderArguments& render_args) {
   } else if (args.technique == "hierarchical") {
     image = render_hierarchical(scene, args.hbe, &stats);
   } else if (args.technique == "fur") {
-    image = render_fur(scene, args.fur, &stats);
+    image = render_fur(scene, args.fur, &stats, args.settings);
   } else {
     RadianceMapOptions options;
     options.max_blur_level = args.max_blur;

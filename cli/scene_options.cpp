@@ -90,7 +90,8 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
                   "translucency, OpenGL, seed 000: not physically based), hierarchical "
                   "(boundary elements on a face-cluster hierarchy, seed 004: the standard dipole, "
                   "solved on the CPU, shaded per vertex on the GPU), fur (seed 001: shells with SH "
-                  "transfer, --mesh tile) or reference (CPU, slow, exact up to sampling noise)")
+                  "transfer; --mesh tile is the seed's tile, other meshes get a coat of shells "
+                  "over the maps' skin: an extension) or reference (CPU, slow, exact up to sampling noise)")
       ->capture_default_str();
   cmd->add_option("--model", args->model,
                   "tabulated (exact to Monte Carlo transport), ddipole (directional dipole) or "
@@ -204,6 +205,16 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
       ->check(whole_in(1, 1024, "fur shells"))
       ->capture_default_str();
   cmd->add_option("--fur-seed", args->fur.seed, "fur: the hair generator's seed")
+      ->capture_default_str();
+  cmd->add_option("--fur-coat", args->fur_coat,
+                  "on: a fur coat over the skin (an extension of seed 001): its transmittance "
+                  "T(cos theta), from the --fur-* hairs, attenuates the light entering the skin "
+                  "(maps, hierarchical, reference)")
+      ->capture_default_str();
+  cmd->add_option("--fur-tile-mm", args->fur.tile_mm,
+                  "fur over a mesh: the tile's width, mm (its texels set the hair scale)")
+      ->capture_default_str();
+  cmd->add_option("--fur-height-mm", args->fur.height_mm, "fur over a mesh: the coat's height, mm")
       ->capture_default_str();
   cmd->add_option("--hbe-irradiance-cache", args->hbe_irradiance_cache,
                   "hierarchical: on: area lights' leaf irradiance from per-cluster projection maps "
@@ -325,15 +336,19 @@ SceneSetup build_scene(SceneArguments& args) {
     }
   }
   args.reference.irradiance_cache = args.irradiance_cache == "on";
-  if (args.technique == "fur") {
+  if (args.fur_coat != "on" && args.fur_coat != "off") {
+    throw Error("--fur-coat: expected on or off, got '" + args.fur_coat + "'");
+  }
+  if (args.fur_coat == "on" && args.technique == "sh") {
+    throw Error("--fur-coat: the sh technique's precomputed transfer has no fur coat; use maps, "
+                "hierarchical or reference");
+  }
+  if (args.technique == "fur" || args.fur_coat == "on") {
     // Hair counts follow the tile's area (the seed's density at 64 x 64 texels).
     const double scale = double(args.fur.texels) * args.fur.texels / (64.0 * 64.0);
     args.fur.overcoat.hairs = int(std::lround(600 * scale));
     args.fur.undercoat.hairs = int(std::lround(2400 * scale));
     args.fur.validate();
-    if (args.mesh != "tile") {
-      throw Error("--technique fur: renders seed 001's flat fur tile: use --mesh tile");
-    }
   }
   args.hbe.irradiance_cache = args.hbe_irradiance_cache == "on";
   if (args.specular != "on" && args.specular != "off") {
@@ -389,6 +404,7 @@ SceneSetup build_scene(SceneArguments& args) {
   scene.roughness = args.roughness;
   scene.specular = args.specular == "on";
   scene.backdrop = backdrop;
+  if (args.fur_coat == "on") scene.fur_coat = render::fur::make_fur_coat(render::fur::over_mesh(args.fur));
   scene.camera = orbit_camera(scene.mesh, float(view[0]), float(view[1]), float(view[2]),
                               int(size[0]), int(size[1]));
   return SceneSetup{std::move(scene), float(view[0]), float(view[1]), float(view[2])};

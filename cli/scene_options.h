@@ -45,7 +45,8 @@ struct SceneArguments {
   std::string sh_fresnel = "exact";  ///< exact | schlick
   std::string sh_attenuation = "slab";  ///< seed | normalised | slab
   render::hbe::Options hbe;        ///< --technique hierarchical: oracle, form factor, mode
-  render::fur::FurOptions fur;     ///< --technique fur: the tile
+  render::fur::FurOptions fur;     ///< --technique fur: the tile; --fur-coat: the coat's hairs
+  std::string fur_coat = "off";    ///< --fur-coat on|off: a fur coat over the skin (fur_coat.h)
   std::string hbe_mode = "render", hbe_rule = "gauss2", hbe_dipole = "chord";
 };
 

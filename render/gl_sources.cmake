@@ -55,6 +55,7 @@ target_sources(lucent_render PRIVATE
   "${LUCENT_GL_DIR}/src/gl_frame.cpp"
   "${LUCENT_GL_DIR}/src/gl_area_lights.cpp"
   "${LUCENT_GL_DIR}/src/fur_renderer.cpp"
+  "${LUCENT_GL_DIR}/src/fur_mesh.cpp"
   "${LUCENT_GL_DIR}/src/gl_program.cpp"
   "${LUCENT_GL_DIR}/src/hierarchical_renderer.cpp"
   "${LUCENT_GL_DIR}/src/radiance_maps.cpp"

@@ -31,6 +31,7 @@ layout(early_fragment_tests) in;
 
 #include "math.glsl"
 #include "fresnel.glsl"
+#include "fur_coat.glsl"
 #include "random.glsl"
 #include "bssrdf_ddipole.glsl"
 #include "bssrdf_dipole.glsl"
@@ -180,7 +181,7 @@ void main() {
       }
       float cos_i = dot(n_i, w_i);
       if (cos_i <= 0.0) continue;  // interpolated normal turned away at a silhouette
-      sum += sample_.z * fresnel_transmittance(cos_i, u_eta) * E * bssrdf(x_i, n_i, w_i, x_o, n_o);
+      sum += sample_.z * fresnel_transmittance(cos_i, u_eta) * fur_coat(cos_i) * E * bssrdf(x_i, n_i, w_i, x_o, n_o);
     }
   }
   vec4 previous = u_has_previous ? texelFetch(u_previous, ivec3(texel, g_layer), 0) : vec4(0.0);

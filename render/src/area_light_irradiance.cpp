@@ -54,7 +54,8 @@ AreaIrradiance area_light_irradiance(const Light& light, const Vec3f& x, const V
       const Vec3f offset = g.dot(wf) >= 0 ? g : Vec3f(-g);
       visible = !rays->occluded(x + eps * offset, wf, r - 2.0 * eps);
     }
-    const double f = visible ? materials::fresnel_transmittance(cos_x, eta) : 0.0;
+    double f = visible ? materials::fresnel_transmittance(cos_x, eta) : 0.0;
+    if (sampling.coat != nullptr) f *= sampling.coat->at(cos_x);
     sum += sampling.control_variate ? (f - 1.0) * h : f * h;
   }
   out.transmitted = area * sum / S + (sampling.control_variate ? out.unshadowed : 0.0);

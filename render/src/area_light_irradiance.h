@@ -3,6 +3,8 @@
 //
 //   E_t / L = integral over the polygon of V(x, p) F_t(eta, cos_x) cos_x cos_p / |p - x|^2 dA_p,
 //
+// (times a fur coat's T(cos_x) beside F_t when there is one: fur_coat.h),
+//
 // estimated with `samples` stratified points p_j uniform by area (Latin-hypercube strata in the
 // two coordinates of area_light_point) and one shadow ray each. With the control variate the
 // estimate is
@@ -27,6 +29,7 @@ struct AreaLightSampling {
   int samples = 4;              ///< points on the polygon (shadow rays) per evaluation
   bool control_variate = true;  ///< add the analytic pi F (see the file comment)
   bool shadows = true;
+  const FurCoat* coat = nullptr;  ///< a fur coat's transmittance per sample (fur_coat.h), or none
 };
 
 struct AreaIrradiance {
@@ -35,8 +38,9 @@ struct AreaIrradiance {
   Vec3f w = Vec3f::Zero();    ///< unit direction of the form factor's vector (toward the light)
 };
 
-inline AreaLightSampling area_light_sampling(const ReferenceOptions& options) {
-  return {options.area_light_samples, options.area_light_control_variate, options.shadows};
+inline AreaLightSampling area_light_sampling(const ReferenceOptions& options, const Scene& scene) {
+  return {options.area_light_samples, options.area_light_control_variate, options.shadows,
+          scene.fur_coat ? &*scene.fur_coat : nullptr};
 }
 
 /// x: the point (mm), n: its shading normal, g: its geometric normal (the shadow-ray offset side),

@@ -53,6 +53,9 @@ void FurOptions::validate() const {
     throw Error("fur: the seed's coverage rule takes hairs at most one texel wide");
   }
   if (quadrature_nodes < 3 || quadrature_nodes > 256) throw Error("fur: quadrature nodes 3..256");
+  if (!(tile_mm > 0) || !(height_mm > 0) || !(tile_mm <= 1e4) || !(height_mm <= 1e4)) {
+    throw Error("--fur-tile-mm, --fur-height-mm: expected lengths in (0, 1e4] mm");
+  }
 }
 
 std::vector<Hair> generate_hairs(const FurOptions& o) {
@@ -249,6 +252,44 @@ void compute_transfer(FurTile& tile, const FurOptions& o, int threads) {
   for (int t = 1; t < threads; ++t) pool.emplace_back(work);
   work();
   for (auto& t : pool) t.join();
+}
+
+FurCoat coat_transmittance(const FurTile& tile, double optical_density, int nodes, int azimuths,
+                           int threads) {
+  if (nodes < 2 || azimuths < 1) throw Error("fur coat: expected >= 2 elevations and >= 1 azimuth");
+  if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+  const int n = tile.texels;
+  FurCoat coat;
+  coat.transmittance.assign(std::size_t(nodes), 0.0f);
+  std::atomic<int> next{0};
+  const auto work = [&] {
+    for (int k; (k = next.fetch_add(1)) < nodes;) {
+      const double mu = double(k + 1) / nodes, s = std::sqrt(std::max(0.0, 1 - mu * mu));
+      double sum = 0;
+      for (int j = 0; j < azimuths; ++j) {
+        const double phi = 2 * kPi * (j + 0.5) / azimuths;
+        const Eigen::Vector3d d(s * std::cos(phi), s * std::sin(phi), mu);
+        for (int y = 0; y < n; ++y)
+          for (int x = 0; x < n; ++x) sum += transmittance(tile, 0, y, x, d, optical_density);
+      }
+      coat.transmittance[std::size_t(k)] = float(sum / (double(azimuths) * n * n));
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+  return coat;
+}
+
+FurOptions over_mesh(FurOptions options) {
+  options.shell_spacing = options.height_mm / options.tile_mm * options.texels / options.shells;
+  return options;
+}
+
+FurCoat make_fur_coat(const FurOptions& options, int threads) {
+  const FurTile tile = rasterize_hairs(generate_hairs(options), options);
+  return coat_transmittance(tile, options.optical_density, 16, 8, threads);
 }
 
 FurTile make_fur_tile(const FurOptions& options, int threads) {

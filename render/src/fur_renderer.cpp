@@ -6,6 +6,7 @@
 
 #include "gl_api.h"
 #include "gl_frame.h"
+#include "fur_gl.h"
 #include "gl_program.h"
 #include "lucent/materials/error.h"
 #include "lucent/render/area_light.h"
@@ -13,6 +14,54 @@
 #include "radiance_maps_sampling.h"
 
 namespace lucent::render {
+
+namespace detail {
+
+gl::Texture upload_fur_transfer(const fur::FurTile& tile) {
+  // 7 RGBA layers per shell: t_0..t_23, then t_24 and the coverage.
+  const int n = tile.texels, S = tile.shells;
+  std::vector<float> layers(std::size_t(n) * n * 4 * 7 * S, 0.0f);
+  for (int s = 0; s < S; ++s) {
+    for (int y = 0; y < n; ++y) {
+      for (int x = 0; x < n; ++x) {
+        const float* t = &tile.transfer[((std::size_t(s) * n + y) * n + x) * kShCoefficients];
+        for (int k = 0; k < 7; ++k) {
+          float* out = &layers[((std::size_t(7 * s + k) * n + y) * n + x) * 4];
+          for (int c = 0; c < 4; ++c) {
+            const int i = 4 * k + c;
+            out[c] = i < kShCoefficients ? t[i] : 0.0f;
+          }
+          if (k == 6) out[1] = tile.at(s, y, x);
+        }
+      }
+    }
+  }
+  gl::Texture transfer = gl::create_texture(GL_TEXTURE_2D_ARRAY);
+  glTextureStorage3D(transfer.id(), 1, GL_RGBA32F, n, n, 7 * S);
+  glTextureSubImage3D(transfer.id(), 0, 0, 0, 0, n, n, 7 * S, GL_RGBA, GL_FLOAT, layers.data());
+  return transfer;
+}
+
+gl::Sampler fur_sampler() {
+  gl::Sampler sampler = gl::create_sampler();
+  glSamplerParameteri(sampler.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glSamplerParameteri(sampler.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glSamplerParameteri(sampler.id(), GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glSamplerParameteri(sampler.id(), GL_TEXTURE_WRAP_T, GL_REPEAT);
+  return sampler;
+}
+
+Vec3f fur_albedo(const materials::Material& material) {
+  Vec3f albedo;
+  for (int c = 0; c < 3; ++c) {
+    const auto md = material.medium(c);
+    const double s_prime = md.sigma_s * (1 - md.g);
+    albedo[c] = s_prime + md.sigma_a > 0 ? float(s_prime / (s_prime + md.sigma_a)) : 0.0f;
+  }
+  return albedo;
+}
+
+}  // namespace detail
 
 namespace {
 
@@ -25,10 +74,29 @@ double now_ms() {
 
 Eigen::Vector3d tile_from_world(const Eigen::Vector3d& w) { return {w.x(), -w.z(), w.y()}; }
 
+Eigen::Matrix3d fur_vertex_frame(const Vec3f& normal) {
+  const Eigen::Vector3d n = normal.cast<double>().normalized();
+  Eigen::Vector3d t = n.cross(Eigen::Vector3d::UnitY());
+  if (t.norm() < 1e-4) t = Eigen::Vector3d::UnitX() - n.x() * n;
+  t.normalize();
+  Eigen::Matrix3d frame;
+  frame.row(0) = t.transpose();
+  frame.row(1) = n.cross(t).transpose();
+  frame.row(2) = n.transpose();
+  return frame;
+}
+
 std::array<ShVector<double>, 3> fur_light_sh(const std::vector<Light>& lights, const Vec3f& centre) {
+  Eigen::Matrix3d tile;
+  tile << 1, 0, 0, 0, 0, -1, 0, 1, 0;  // tile_from_world
+  return fur_light_sh(lights, centre, tile);
+}
+
+std::array<ShVector<double>, 3> fur_light_sh(const std::vector<Light>& lights, const Vec3f& centre,
+                                             const Eigen::Matrix3d& to_local) {
   std::array<ShVector<double>, 3> c{};
   const auto add = [&](const Eigen::Vector3d& world_dir, const Eigen::Vector3d& rgb) {
-    const ShVector<double> y = sh_basis<double>(Eigen::Vector3d(tile_from_world(world_dir.normalized())));
+    const ShVector<double> y = sh_basis<double>(Eigen::Vector3d(to_local * world_dir.normalized()));
     for (int ch = 0; ch < 3; ++ch)
       for (int i = 0; i < kShCoefficients; ++i) c[std::size_t(ch)][std::size_t(i)] += rgb[ch] * y[std::size_t(i)];
   };
@@ -92,8 +160,8 @@ FurRenderer::~FurRenderer() = default;
 void FurRenderer::setup(const Scene& scene, const fur::FurOptions& options) {
   Impl& m = *impl_;
   if (scene.mesh.name != "tile") {
-    throw Error("--technique fur: renders seed 001's flat tile (--mesh tile); fur over other meshes "
-                "is not built yet");
+    throw Error("--technique fur: the interactive fur is seed 001's flat tile (--mesh tile); fur "
+                "over a mesh renders with lucent render --technique fur");
   }
   if (scene.lights.empty()) throw Error("--light: the fur technique needs at least one light");
   m.scene = scene;
@@ -111,32 +179,8 @@ void FurRenderer::setup(const Scene& scene, const fur::FurOptions& options) {
   m.tile = fur::make_fur_tile(m.options);
   m.precompute_ms = now_ms() - t0;
 
-  // 7 RGBA layers per shell: t_0..t_23, then t_24 and the coverage.
-  const int n = m.options.texels, S = m.options.shells;
-  std::vector<float> layers(std::size_t(n) * n * 4 * 7 * S, 0.0f);
-  for (int s = 0; s < S; ++s) {
-    for (int y = 0; y < n; ++y) {
-      for (int x = 0; x < n; ++x) {
-        const float* t = &m.tile.transfer[((std::size_t(s) * n + y) * n + x) * kShCoefficients];
-        for (int k = 0; k < 7; ++k) {
-          float* out = &layers[((std::size_t(7 * s + k) * n + y) * n + x) * 4];
-          for (int c = 0; c < 4; ++c) {
-            const int i = 4 * k + c;
-            out[c] = i < kShCoefficients ? t[i] : 0.0f;
-          }
-          if (k == 6) out[1] = m.tile.at(s, y, x);
-        }
-      }
-    }
-  }
-  m.transfer = gl::create_texture(GL_TEXTURE_2D_ARRAY);
-  glTextureStorage3D(m.transfer.id(), 1, GL_RGBA32F, n, n, 7 * S);
-  glTextureSubImage3D(m.transfer.id(), 0, 0, 0, 0, n, n, 7 * S, GL_RGBA, GL_FLOAT, layers.data());
-  m.sampler = gl::create_sampler();
-  glSamplerParameteri(m.sampler.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glSamplerParameteri(m.sampler.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glSamplerParameteri(m.sampler.id(), GL_TEXTURE_WRAP_S, GL_REPEAT);
-  glSamplerParameteri(m.sampler.id(), GL_TEXTURE_WRAP_T, GL_REPEAT);
+  m.transfer = detail::upload_fur_transfer(m.tile);
+  m.sampler = detail::fur_sampler();
   m.vao = gl::create_vertex_array();
   m.program = gl::Program({{GL_VERTEX_SHADER, "fur.vert"}, {GL_FRAGMENT_SHADER, "fur.frag"}});
   m.background_program = gl::Program(
@@ -152,13 +196,7 @@ void FurRenderer::setup(const Scene& scene, const fur::FurOptions& options) {
   glNamedFramebufferTexture(m.fbo.id(), GL_COLOR_ATTACHMENT0, m.color.id(), 0);
   glNamedFramebufferRenderbuffer(m.fbo.id(), GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, m.depth.id());
   gl::check_framebuffer(m.fbo.id(), "the fur image");
-  // Hair colour: the material's reduced albedo per channel.
-  Vec3f albedo;
-  for (int c = 0; c < 3; ++c) {
-    const auto md = scene.material.medium(c);
-    const double s_prime = md.sigma_s * (1 - md.g);
-    albedo[c] = s_prime + md.sigma_a > 0 ? float(s_prime / (s_prime + md.sigma_a)) : 0.0f;
-  }
+  const Vec3f albedo = detail::fur_albedo(scene.material);
   glProgramUniform3fv(m.program.id(), m.program.location("u_albedo"), 1, albedo.data());
   m.upload_lights();
   gl::check_errors("fur setup");
@@ -233,7 +271,9 @@ ImageRgb FurRenderer::read_image() const {
 double FurRenderer::precompute_ms() const { return impl_->precompute_ms; }
 double FurRenderer::draw_ms() const { return impl_->draw_ms; }
 
-ImageRgb render_fur(const Scene& scene, const fur::FurOptions& options, RenderStats* stats) {
+ImageRgb render_fur(const Scene& scene, const fur::FurOptions& options, RenderStats* stats,
+                    const RenderSettings& skin) {
+  if (scene.mesh.name != "tile") return render_fur_mesh(scene, options, skin, stats);
   const double t0 = now_ms();
   const auto context = GlContext::create_headless();
   FurRenderer renderer;

@@ -100,4 +100,17 @@ void set_bssrdf_uniforms(GLuint program, const materials::Material& material) {
   set("u_eta", float(material.ior));
 }
 
+void set_fur_coat_uniforms(GLuint program, const std::optional<FurCoat>& coat) {
+  const int n = coat ? int(coat->transmittance.size()) : 0;
+  if (coat && (n < 2 || n > kMaxFurCoatNodes)) {
+    throw Error("fur coat: expected 2.." + std::to_string(kMaxFurCoatNodes) +
+                " elevations for the GPU, got " + std::to_string(n));
+  }
+  glProgramUniform1i(program, glGetUniformLocation(program, "u_fur_coat_nodes"), n);
+  if (n > 0) {
+    glProgramUniform1fv(program, glGetUniformLocation(program, "u_fur_coat"), n,
+                        coat->transmittance.data());
+  }
+}
+
 }  // namespace lucent::render::gl

@@ -4,12 +4,14 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <vector>
 
 #include "gl_api.h"
 #include "gl_program.h"
 #include "lucent/materials/material.h"
 #include "lucent/materials/medium.h"
+#include "lucent/render/fur_coat.h"
 
 namespace lucent::render::gl {
 
@@ -48,5 +50,11 @@ DipoleChannelData dipole_channel_data(const materials::Medium<double>& medium);
 /// Sets `u_ddipole[0..2]` and `u_dipole[0..2]` (uniform arrays of the structs above) and `u_eta` in
 /// `program` (which must be in use) from the material's three channels.
 void set_bssrdf_uniforms(GLuint program, const materials::Material& material);
+
+inline constexpr int kMaxFurCoatNodes = 32;  ///< LUCENT_MAX_FUR_COAT_NODES of fur_coat.glsl
+
+/// Sets `u_fur_coat_nodes` and `u_fur_coat` (fur_coat.glsl) in `program`: the coat's nodes, or
+/// 0 nodes (T = 1) without one. Throws lucent::Error for a coat of more than kMaxFurCoatNodes.
+void set_fur_coat_uniforms(GLuint program, const std::optional<FurCoat>& coat);
 
 }  // namespace lucent::render::gl

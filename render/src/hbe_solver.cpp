@@ -282,6 +282,7 @@ struct Solver::Impl {
       detail::IrradianceCacheOptions co;
       co.shadow_samples = kAreaLightSamples;
       co.shadows = o.shadows;
+      co.coat = scene.fur_coat ? &*scene.fur_coat : nullptr;
       cache = std::make_unique<detail::IrradianceCache>(mesh, scene.lights, rays.get(), eta, co);
     }
     for (std::size_t t = 0; t < T; ++t) {
@@ -308,6 +309,7 @@ struct Solver::Impl {
           detail::AreaLightSampling sampling;
           sampling.samples = kAreaLightSamples;
           sampling.shadows = o.shadows;
+          sampling.coat = scene.fur_coat ? &*scene.fur_coat : nullptr;
           const detail::AreaIrradiance a = detail::area_light_irradiance(
               light, x, n, g, rays.get(), eps, eta, sampling,
               detail::mix(std::uint64_t(t) * 0x9E3779B97F4A7C15ull + l));
@@ -324,7 +326,8 @@ struct Solver::Impl {
           const Vec3f offset = g.dot(w) >= 0 ? g : Vec3f(-g);
           if (rays->occluded(x + eps * offset, w, distance - eps)) continue;
         }
-        const double f = falloff * cos_i * materials::fresnel_transmittance(cos_i, eta);
+        const double f = falloff * cos_i * materials::fresnel_transmittance(cos_i, eta) *
+                         (scene.fur_coat ? scene.fur_coat->at(cos_i) : 1.0);
         for (int ch = 0; ch < 3; ++ch) face_E[t][std::size_t(ch)] += f * light.radiance[ch];
       }
     }

@@ -165,6 +165,7 @@ void IrradianceCache::evaluate(Vertex& v) const {
   AreaLightSampling sampling;
   sampling.samples = options_.shadow_samples;
   sampling.shadows = options_.shadows;
+  sampling.coat = options_.coat;
   Vec3f w = Vec3f::Zero();
   for (std::size_t l = 0; l < lights_.size(); ++l) {
     const AreaIrradiance a =

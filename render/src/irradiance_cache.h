@@ -33,6 +33,7 @@ struct IrradianceCacheOptions {
   double texel_mm = 0;               ///< grid spacing; 0 = the bounding radius / 64
   int shadow_samples = 16;           ///< per grid vertex (area_light_irradiance)
   bool shadows = true;
+  const FurCoat* coat = nullptr;     ///< a fur coat's transmittance (fur_coat.h), or none
 };
 
 struct IrradianceCacheStats {

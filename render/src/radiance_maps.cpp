@@ -388,6 +388,7 @@ void RadianceMapRenderer::Impl::upload_disc(int t, bool redraw) {
 
 void RadianceMapRenderer::Impl::upload_material() {
   gl::set_bssrdf_uniforms(radiance_program.id(), scene.material);
+  gl::set_fur_coat_uniforms(radiance_program.id(), scene.fur_coat);
   if (settings.model == DiffusionModel::kTabulated) {
     gl::set_tabulated(radiance_program.id(), scene.material, kUnitTabulated, tabulated_rows);
   }

@@ -55,7 +55,7 @@ void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions
                                                ChannelBssrdf(scene.material.medium(1), model),
                                                ChannelBssrdf(scene.material.medium(2), model)};
   const bool per_light = model == DiffusionModel::kDirectionalDipole;
-  const AreaLightSampling area_sampling = area_light_sampling(options);
+  const AreaLightSampling area_sampling = area_light_sampling(options, scene);
   const double R = density.r_max();
   const float eps = 1e-4f * std::max(mesh.bounding_radius(), 1e-6f);
   const int S = std::max(1, options.pixel_samples);
@@ -179,8 +179,8 @@ void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions
                   const Vec3f off = g_f.dot(w) >= 0 ? g_f : Vec3f(-g_f);
                   if (rays.occluded(x_f + eps * off, w, distance - eps)) continue;
                 }
-                const double factor =
-                    scale * cos_i * materials::fresnel_transmittance(cos_i, eta) / pdf;
+                const double factor = scale * cos_i * materials::fresnel_transmittance(cos_i, eta) *
+                                      (scene.fur_coat ? scene.fur_coat->at(cos_i) : 1.0) / pdf;
                 const Vec3d w_i = w.cast<double>();
                 for (int c = 0; c < 3; ++c) {
                   const double s_d = per_light ? bssrdf[c](x_i, n_i, w_i, x_o, n_o) : radial[c];

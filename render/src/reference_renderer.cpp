@@ -416,7 +416,7 @@ ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
   const std::size_t groups = per_light ? scene.lights.size() : (scene.lights.empty() ? 0 : 1);
   const std::size_t N = std::size_t(options.surface_samples);
   const SurfaceSampler sampler(mesh);
-  const AreaLightSampling area_sampling = area_light_sampling(options);
+  const AreaLightSampling area_sampling = area_light_sampling(options, scene);
   std::unique_ptr<IrradianceCache> cache;
   if (options.irradiance_cache &&
       std::any_of(scene.lights.begin(), scene.lights.end(),
@@ -425,6 +425,7 @@ ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
     co.texel_mm = options.irradiance_cache_texel_mm;
     co.shadow_samples = options.irradiance_cache_samples;
     co.shadows = options.shadows;
+    co.coat = area_sampling.coat;
     cache = std::make_unique<IrradianceCache>(mesh, scene.lights, &rays, eta, co);
   }
   const double area_per_sample = sampler.area() / double(N);
@@ -509,7 +510,8 @@ ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
               if (rays.occluded(xs[k] + eps * offset, w, distance - eps)) continue;
             }
             const double factor = area_per_sample * irradiance_scale * cos_i *
-                                  materials::fresnel_transmittance(cos_i, eta);
+                                  materials::fresnel_transmittance(cos_i, eta) *
+                                  (scene.fur_coat ? scene.fur_coat->at(cos_i) : 1.0);
             r.w = w;
             for (int c = 0; c < 3; ++c) r.E[c] += float(factor * light.radiance[c]);
           }

@@ -10,6 +10,10 @@ ShRenderer::ShRenderer() : impl_(std::make_unique<Impl>()) {}
 ShRenderer::~ShRenderer() = default;
 
 void ShRenderer::setup(const Scene& scene, const ShOptions& options) {
+  if (scene.fur_coat) {
+    throw Error("--fur-coat: the sh technique's precomputed transfer has no fur coat; use maps, "
+                "hierarchical or reference");
+  }
   const double t0 = now_ms();
   impl_ = std::make_unique<Impl>();
   impl_->build(scene, options);

@@ -16,12 +16,18 @@ lucent_add_test(sh_renderer_test
 lucent_add_test(fur_renderer_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/fur_renderer_test.cpp
   LIBS lucent::render lucent::materials OpenGL::OpenGL)
+lucent_add_test(fur_coat_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/fur_coat_test.cpp
+  LIBS lucent::render lucent::materials OpenGL::OpenGL)
+lucent_add_test(fur_glsl_twin_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/fur_glsl_twin_test.cpp
+  LIBS lucent::render lucent::materials OpenGL::OpenGL)
 lucent_add_test(area_light_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/area_light_test.cpp
   LIBS lucent::render lucent::materials OpenGL::OpenGL)
 # White-box: both include headers from render/src (gl_program.h, gl_bssrdf.h,
 # radiance_maps_sampling.h).
-foreach(t glsl_twin_test radiance_maps_test sh_renderer_test area_light_test)
+foreach(t glsl_twin_test radiance_maps_test sh_renderer_test area_light_test fur_glsl_twin_test)
   target_include_directories(${t} PRIVATE ${PROJECT_SOURCE_DIR}/render/src)
 endforeach()
 lucent_add_test(hierarchical_renderer_test

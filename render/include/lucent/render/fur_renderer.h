@@ -24,8 +24,21 @@ namespace lucent::render {
 /// light I / r^2 Y_i(w), an area light by 64 stratified points L cos_p dA / r^2 Y_i(w).
 std::array<ShVector<double>, 3> fur_light_sh(const std::vector<Light>& lights, const Vec3f& centre);
 
-/// The world direction of a tile-frame direction and back.
+/// The same in the frame whose axes are the rows of `to_local` (a rotation: tangent, bitangent,
+/// normal), so that local z is the hairs' up: the light's SH turned into a vertex's frame. For
+/// these lights the basis is evaluated at the turned directions: exactly the rotation of the
+/// world-frame coefficients (sh_rotate), without its cost.
+std::array<ShVector<double>, 3> fur_light_sh(const std::vector<Light>& lights, const Vec3f& centre,
+                                             const Eigen::Matrix3d& to_local);
+
+/// The tile-frame direction of a world direction (the tile's frame: x, -z, y).
 Eigen::Vector3d tile_from_world(const Eigen::Vector3d& w);
+
+/// The frame of a vertex with unit normal n for fur over a mesh (rows: tangent, bitangent, n): the
+/// tangent along n x (world +y), or along world +x at the poles (|n . y| > 0.9999). The tile's
+/// hairs are statistically isotropic in azimuth, so any continuous tangent serves; this one turns
+/// only near the poles.
+Eigen::Matrix3d fur_vertex_frame(const Vec3f& n);
 
 class FurRenderer {
  public:
@@ -53,7 +66,20 @@ class FurRenderer {
   std::unique_ptr<Impl> impl_;
 };
 
-/// One frame in a headless context (stats: technique "fur", precompute and draw times).
-ImageRgb render_fur(const Scene& scene, const fur::FurOptions& options, RenderStats* stats = nullptr);
+/// One frame in a headless context (stats: technique "fur", precompute and draw times). On the
+/// tile, seed 001; on any other mesh, the extension: `skin` (the radiance maps' settings) renders
+/// the BSSRDF under the coat (scene.fur_coat, or the tile's own coat_transmittance), then the
+/// shells are drawn over it (fur_mesh.cpp).
+ImageRgb render_fur(const Scene& scene, const fur::FurOptions& options, RenderStats* stats = nullptr,
+                    const RenderSettings& skin = {});
+
+/// Fur shells over a mesh (the extension of seed 001): `render_fur` for meshes other than the
+/// tile. Shells at (s + 0.5) height_mm / shells along the vertex normals, the tile mapped by its
+/// width tile_mm onto the surface by triplanar projection (weights |n_a|^4), the lights' SH
+/// evaluated per vertex in fur_vertex_frame and interpolated, alpha-blended inner to outer over
+/// the skin image, which the mesh's depth occludes. No mesh-scale shadows on the hairs (the skin
+/// has them: it comes from the maps).
+ImageRgb render_fur_mesh(const Scene& scene, const fur::FurOptions& options,
+                         const RenderSettings& skin, RenderStats* stats = nullptr);
 
 }  // namespace lucent::render

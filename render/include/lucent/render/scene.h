@@ -14,6 +14,7 @@
 #include <Eigen/Geometry>
 
 #include "lucent/materials/material.h"
+#include "lucent/render/fur_coat.h"
 
 namespace lucent::render {
 
@@ -75,6 +76,9 @@ struct Scene {
   float roughness = 0.1f;
   bool specular = true;  ///< `--specular off` renders the subsurface term alone
   Vec3f backdrop{0, 0, 0};  ///< radiance of the background where no environment map is given
+  /// A fur coat over the skin (fur_coat.h, an extension of seed 001): the maps and the reference
+  /// attenuate each light sample's transmitted irradiance by its T(n . w_i). `--fur-coat on`.
+  std::optional<FurCoat> fur_coat;
 };
 
 /// Parses `directional:DX,DY,DZ:R,G,B`, `point:X,Y,Z:R,G,B` or
