@@ -6,6 +6,7 @@
 #define LUCENT_AREA_LIGHT_GLSL
 
 #include "form_factor.glsl"
+#include "fur_coat.glsl"
 #include "specular.glsl"
 
 // Per slot, LUCENT_MAX_POLYGON_VERTICES entries: xyz a vertex (mm); the w components hold the
@@ -33,7 +34,8 @@ vec3 area_light_normal(int slot) {
 // Shading in Unreal Engine 4"): the point of the polygon nearest the mirror ray, lit with the exact
 // irradiance pi F over its cosine, the lobe's energy normalised by (alpha / alpha')^2 with
 // alpha' = alpha + r / (2 d), r the radius of a disc of the polygon's area. An approximation (the
-// CPU reference integrates the lobe over the polygon); no shadow test.
+// CPU reference integrates the lobe over the polygon); no shadow test. Under a fur coat the
+// lobe takes the coat's T at the representative point's cosine (fur_coat.glsl).
 float area_specular(int slot, vec3 x, vec3 n, vec3 w_o, float alpha, float eta) {
   float cos_o = dot(n, w_o);
   if (!(cos_o > 0.0) || !(alpha > 0.0)) return 0.0;
@@ -70,7 +72,7 @@ float area_specular(int slot, vec3 x, vec3 n, vec3 w_o, float alpha, float eta) 
   float widened = min(alpha + 0.5 * radius / dist, 1.0);
   float normalisation = (alpha / widened) * (alpha / widened);
   vec3 h = normalize(w + w_o);
-  return kPi * ff.F / cos_i * normalisation *
+  return kPi * ff.F / cos_i * normalisation * fur_coat(cos_i) *
          ggx_reflection(cos_i, cos_o, dot(n, h), dot(h, w), alpha, eta);
 }
 

@@ -16,6 +16,7 @@
 #include "fresnel.glsl"
 #include "environment.glsl"
 #include "specular.glsl"
+#include "fur_coat.glsl"
 #ifdef LUCENT_AREA_LIGHTS
 #include "area_light.glsl"
 #endif
@@ -93,7 +94,7 @@ vec3 specular_lights(vec3 x_o, vec3 n_o, vec3 w_o) {
     if (!(cos_i > 0.0) || !lit_by(l, x_o, n_o, w)) continue;
     vec3 E = u_light_radiance[l] / (is_point ? dot(to_light, to_light) : 1.0);
     vec3 h = normalize(w + w_o);
-    sum += E * ggx_reflection(cos_i, cos_o, dot(n_o, h), dot(h, w), u_roughness, u_eta);
+    sum += E * fur_coat(cos_i) * ggx_reflection(cos_i, cos_o, dot(n_o, h), dot(h, w), u_roughness, u_eta);
   }
   return sum;
 }

@@ -6,6 +6,7 @@
 #include "fresnel.glsl"
 #include "environment.glsl"
 #include "specular.glsl"
+#include "fur_coat.glsl"
 #ifdef LUCENT_AREA_LIGHTS
 #include "area_light.glsl"
 #endif
@@ -55,7 +56,7 @@ void main() {
       float cos_i = dot(n_o, w);
       if (!(cos_i > 0.0)) continue;
       vec3 h = normalize(w + w_o);
-      L += E * ggx_reflection(cos_i, cos_o, dot(n_o, h), dot(h, w), u_roughness, u_eta);
+      L += E * fur_coat(cos_i) * ggx_reflection(cos_i, cos_o, dot(n_o, h), dot(h, w), u_roughness, u_eta);
     }
   }
   out_color = vec4(L, 1.0);

@@ -6,6 +6,7 @@
 
 #include "gl_api.h"
 #include "gl_area_lights.h"
+#include "gl_bssrdf.h"
 #include "gl_frame.h"
 #include "gl_program.h"
 #include "lucent/materials/error.h"
@@ -68,6 +69,7 @@ struct HierarchicalRenderer::Impl {
     }
     const GLuint id = program.id();
     gl::upload_area_lights(id, scene.lights);
+    gl::set_fur_coat_uniforms(id, scene.fur_coat);  // the specular lobe's light under a coat
     glProgramUniform1i(id, program.location("u_light_count"), GLint(scene.lights.size()));
     glProgramUniform4fv(id, program.location("u_light_position"), kMaxLights, position.data());
     glProgramUniform3fv(id, program.location("u_light_radiance"), kMaxLights, radiance.data());

@@ -389,6 +389,7 @@ void RadianceMapRenderer::Impl::upload_disc(int t, bool redraw) {
 void RadianceMapRenderer::Impl::upload_material() {
   gl::set_bssrdf_uniforms(radiance_program.id(), scene.material);
   gl::set_fur_coat_uniforms(radiance_program.id(), scene.fur_coat);
+  gl::set_fur_coat_uniforms(final_program.id(), scene.fur_coat);  // the specular lobe's light
   if (settings.model == DiffusionModel::kTabulated) {
     gl::set_tabulated(radiance_program.id(), scene.material, kUnitTabulated, tabulated_rows);
   }

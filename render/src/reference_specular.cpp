@@ -8,7 +8,8 @@ namespace lucent::render::detail {
 
 // The specular lobe of every light at a pixel's point (materials/specular.h), with a shadow ray.
 // Area lights: the mean over kAreaSpecularSamples stratified points of the polygon (shadow ray,
-// GGX, L cos_p / r^2 dA), unbiased like the subsurface term.
+// GGX, L cos_p / r^2 dA), unbiased like the subsurface term. Under a fur coat (fur_coat.h) the
+// light reaching the surface is T(cos_i) of itself, as for the subsurface term.
 constexpr int kAreaSpecularSamples = 16;
 
 Vec3f specular_radiance(const Scene& scene, const RayScene& rays, const PixelHit& hit, float eps,
@@ -20,7 +21,8 @@ Vec3f specular_radiance(const Scene& scene, const RayScene& rays, const PixelHit
   const auto lobe = [&](const Vec3f& w, double cos_i) {
     const Vec3f h = (w + hit.w_o).normalized();
     return materials::ggx_reflection<double>(cos_i, cos_o, hit.n_o.dot(h), h.dot(w),
-                                             scene.roughness, scene.material.ior);
+                                             scene.roughness, scene.material.ior) *
+           (scene.fur_coat ? scene.fur_coat->at(cos_i) : 1.0);
   };
   for (const Light& light : scene.lights) {
     if (light.type == LightType::kArea) {

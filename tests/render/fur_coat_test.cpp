@@ -1,16 +1,19 @@
 // A fur coat over the skin (render/include/lucent/render/fur_coat.h, an extension of seed 001):
 // its transmittance T(mu) against Beer-Lambert for a homogeneous coat, against the tile's own SH
 // transfer for real hairs, and the renders (the reference and the maps) on the large slab against
-// the closed form times exp(-tau / mu), at normal and oblique light.
+// the closed form times exp(-tau / mu), at normal and oblique light; the specular lobe (reference,
+// maps, hierarchical) lit through the coat as well.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <numbers>
 
 #include "gl_fixture.h"
 #include "lucent/materials/fresnel.h"
 #include "lucent/render/fur.h"
+#include "lucent/render/hierarchical_renderer.h"
 #include "lucent/render/radiance_maps.h"
 #include "lucent/render/reference_renderer.h"
 #include "slab_scene.h"
@@ -131,6 +134,48 @@ TEST(FurCoatSlab, ReferenceMatchesTheClosedFormThroughTheCoat) {
   }
 }
 
+// The specular lobe is lit through the coat as well: on the flat face under directional light
+// every point sees the light at cos theta = mu, so the specular term (render with the lobe minus
+// render without, the same seed) is the bare one times T(mu) = exp(-tau / mu), exactly.
+double specular_centre(const Scene& scene, bool specular, int c,
+                       const std::function<ImageRgb(const Scene&)>& render) {
+  Scene s = scene;
+  s.specular = specular;
+  return testing_slab::centre_mean(render(s), c);
+}
+
+void expect_specular_through_the_coat(const std::function<ImageRgb(const Scene&)>& render,
+                                      const char* what, double bound) {
+  const double mu = 0.6;
+  testing_slab::SlabScene slab = coated_slab("marble", mu);
+  slab.scene.roughness = 0.6f;  // wide enough for the camera on the normal to see the lobe at mu
+  Scene bare = slab.scene;
+  bare.fur_coat.reset();
+  for (int ch = 0; ch < 3; ++ch) {
+    const double coated = specular_centre(slab.scene, true, ch, render) -
+                          specular_centre(slab.scene, false, ch, render);
+    const double lobe = specular_centre(bare, true, ch, render) - specular_centre(bare, false, ch, render);
+    ASSERT_GT(lobe, 0) << what << " channel " << ch;
+    const double ratio = coated / lobe, truth = std::exp(-kTau / mu);
+    std::printf("%s specular through the coat ch %d: ratio %.6f vs T(mu) %.6f: %+.3f%%\n", what, ch,
+                ratio, truth, 100 * (ratio / truth - 1));
+    EXPECT_NEAR(ratio / truth, 1.0, bound) << what << " channel " << ch;
+  }
+}
+
+TEST(FurCoatSlab, ReferenceSpecularLobeIsLitThroughTheCoat) {
+  // 1e-3: the two renders share their seed and the lobe is one deterministic factor per pixel;
+  // what is left is float rounding of a difference of two sums.
+  expect_specular_through_the_coat(
+      [](const Scene& s) {
+        ReferenceOptions options;
+        options.pixel_samples = 16;
+        options.threads = 2;
+        return render_reference(s, DiffusionModel::kDipole, options).image;
+      },
+      "reference", 1e-3);
+}
+
 class FurCoatGlTest : public testing_gl::GlTest {};
 
 // The maps at the slab test's tiny settings (K 8, N 16 of M 256, 16 frames, W 32); bound 3%, the
@@ -155,6 +200,26 @@ TEST_F(FurCoatGlTest, RadianceMapsMatchTheClosedFormThroughTheCoat) {
       EXPECT_NEAR(got / truth, 1.0, 0.03) << "mu " << mu << " channel " << ch;
     }
   }
+}
+
+// The maps' and the hierarchical technique's lobes (final.frag, hbe.frag): deterministic renders,
+// so the ratio is float rounding alone (1e-3).
+TEST_F(FurCoatGlTest, MapsAndHierarchicalSpecularLobesAreLitThroughTheCoat) {
+  LUCENT_SKIP_WITHOUT_GL();
+  expect_specular_through_the_coat(
+      [](const Scene& s) {
+        RenderSettings settings;
+        settings.model = DiffusionModel::kDipole;
+        settings.directions = 4;
+        settings.samples = 8;
+        settings.disc_points = 64;
+        settings.frames = 2;
+        settings.radiance_map_size = settings.light_map_size = 32;
+        return render_radiance_maps(s, settings);
+      },
+      "maps", 1e-3);
+  expect_specular_through_the_coat(
+      [](const Scene& s) { return render_hierarchical(s, hbe::Options{}); }, "hierarchical", 1e-3);
 }
 
 }  // namespace
