@@ -1,9 +1,11 @@
 // `lucent bench`: the speed/accuracy sweeps (DESIGN §8), written to notebooks_data/bench/.
+#include <cstdio>
 #include <iostream>
 #include <memory>
 
 #include "commands.h"
 #include "lucent/materials/atomic_file.h"
+#include "lucent/materials/error.h"
 #include "lucent/fit/fit_bench.h"
 #include "lucent/render/render_bench.h"
 #include "lucent/render/tradeoff_bench.h"
@@ -64,6 +66,41 @@ void register_bench_command(CLI::App& app) {
     const int n = render::run_render_bench(*render_options, std::cout);
     std::cout << "bench render: " << n << " meshes; wrote " << render_options->out_csv.string()
               << "\n";
+  });
+
+  auto fur_options = std::make_shared<render::FurBenchOptions>();
+  auto fur_size = std::make_shared<std::string>("1280x1024");
+  CLI::App* fur_cmd = bench->add_subcommand(
+      "fur",
+      "Time the fur tile (seed 001) at the seed's 1280 x 1024 for each shell count: the CPU "
+      "precompute and the median draw per frame -> fur.csv");
+  fur_cmd->add_option("--out", fur_options->out_csv, "CSV to write")->capture_default_str();
+  fur_cmd->add_option("--shells", fur_options->shells, "shell counts to time (a row each)")
+      ->delimiter(',')
+      ->capture_default_str();
+  fur_cmd->add_option("--texels", fur_options->texels, "the tile's texels across")
+      ->check(CLI::Range(2, 4096))
+      ->capture_default_str();
+  fur_cmd->add_option("--frames", fur_options->frames, "frames timed per row (median reported)")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  fur_cmd->add_option("--size", *fur_size, "WxH, pixels")->capture_default_str();
+  fur_cmd->callback([fur_options, fur_size] {
+    check_output_folder(fur_options->out_csv);
+    int w = 0, h = 0, end = 0;
+    if (std::sscanf(fur_size->c_str(), "%dx%d%n", &w, &h, &end) != 2 ||
+        end != int(fur_size->size()) || w < 1 || h < 1 || w > 16384 || h > 16384) {
+      throw lucent::Error("--size: expected WxH, whole numbers 1..16384, got '" + *fur_size + "'");
+    }
+    fur_options->width = w;
+    fur_options->height = h;
+    for (const int s : fur_options->shells) {
+      if (s < 1 || s > 1024) {
+        throw lucent::Error("--shells: expected counts in 1..1024, got " + std::to_string(s));
+      }
+    }
+    const int n = render::run_fur_bench(*fur_options, std::cout);
+    std::cout << "bench fur: " << n << " rows; wrote " << fur_options->out_csv.string() << '\n';
   });
 
   auto tradeoff = std::make_shared<render::TradeoffBenchOptions>();

@@ -1,8 +1,8 @@
 // A fur coat over the skin (render/include/lucent/render/fur_coat.h, an extension of seed 001):
 // its transmittance T(mu) against Beer-Lambert for a homogeneous coat, against the tile's own SH
 // transfer for real hairs, and the renders (the reference and the maps) on the large slab against
-// the closed form times exp(-tau / mu), at normal and oblique light; the specular lobe (reference,
-// maps, hierarchical) lit through the coat as well.
+// the closed form times exp(-tau / mu), at normal and oblique light; the hierarchical technique's
+// subsurface term and the specular lobe (reference, maps, hierarchical) lit through the coat too.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -220,6 +220,50 @@ TEST_F(FurCoatGlTest, MapsAndHierarchicalSpecularLobesAreLitThroughTheCoat) {
       "maps", 1e-3);
   expect_specular_through_the_coat(
       [](const Scene& s) { return render_hierarchical(s, hbe::Options{}); }, "hierarchical", 1e-3);
+}
+
+// The hierarchical technique's subsurface term under the coat (its leaves' irradiance times
+// T(mu), hbe_solver.cpp). It shades per vertex, so the slab's 12 triangles (vertices only at the
+// corners, where the lit side meets the top) say nothing; an open 40 mm plane of 2 mm quads lit
+// at mu has every leaf lit at mu, so the coated centre over the bare one is exp(-tau / mu)
+// whatever the hierarchy's own error. Deterministic: bound 1e-3 (float rounding).
+TEST_F(FurCoatGlTest, HierarchicalSubsurfaceIsLitThroughTheCoat) {
+  LUCENT_SKIP_WITHOUT_GL();
+  for (const double mu : {1.0, 0.6}) {
+    testing_slab::SlabScene slab = coated_slab("marble", mu);
+    slab.scene.specular = false;
+    Mesh& m = slab.scene.mesh;
+    m = Mesh{};
+    m.name = "plane";
+    const int n = 20;
+    const float half = 20.0f, y = 25.0f;
+    for (int j = 0; j <= n; ++j) {
+      for (int i = 0; i <= n; ++i) {
+        m.positions.emplace_back(-half + 2 * half * i / n, y, -half + 2 * half * j / n);
+        m.normals.emplace_back(0.0f, 1.0f, 0.0f);
+      }
+    }
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        const unsigned a = unsigned(j * (n + 1) + i), b = a + 1, c = a + unsigned(n + 1), d = c + 1;
+        m.triangles.push_back({a, c, d});  // counter-clockwise seen from +y
+        m.triangles.push_back({a, d, b});
+      }
+    }
+    Scene bare = slab.scene;
+    bare.fur_coat.reset();
+    const ImageRgb coated = render_hierarchical(slab.scene, hbe::Options{});
+    const ImageRgb plain = render_hierarchical(bare, hbe::Options{});
+    for (int ch = 0; ch < 3; ++ch) {
+      const double lit = testing_slab::centre_mean(plain, ch);
+      ASSERT_GT(lit, 0) << "mu " << mu << " channel " << ch;
+      const double ratio = testing_slab::centre_mean(coated, ch) / lit;
+      const double truth = std::exp(-kTau / mu);
+      std::printf("hierarchical subsurface through the coat mu %.1f ch %d: ratio %.6f vs T(mu) "
+                  "%.6f: %+.3f%%\n", mu, ch, ratio, truth, 100 * (ratio / truth - 1));
+      EXPECT_NEAR(ratio / truth, 1.0, 1e-3) << "mu " << mu << " channel " << ch;
+    }
+  }
 }
 
 }  // namespace

@@ -26,4 +26,22 @@ struct RenderBenchOptions {
 /// Renders each mesh with each disc selection, one row each; returns the rows written.
 int run_render_bench(const RenderBenchOptions& options, std::ostream& log);
 
+/// `lucent bench fur`: the fur tile of seed 001 at the seed's 1280 x 1024 (its Table 1: 40 fps on
+/// a GeForce 6800 SLI), one row per shell count: the CPU precompute (hairs, cross-sections,
+/// transfer) and the per-frame draw (glFinish and a wall clock; the median of `frames` after a
+/// first, compiling frame), from the render command's default view (the tile on part of the
+/// frame) and from close by (the frame filled), with the fraction of pixels the fur covers.
+struct FurBenchOptions {
+  std::filesystem::path out_csv = "notebooks_data/bench/fur.csv";
+  std::vector<int> shells = {16, 32, 64};  ///< the seed's 32 and a halving and doubling
+  int texels = 64;                         ///< the seed's tile, texels across
+  std::vector<float> distances = {3.4f, 1.6f};  ///< camera distances, bounding radii
+  int frames = 5;
+  int width = 1280, height = 1024;
+  std::string material = "marble";
+};
+
+/// Times the tile at each shell count; returns the rows written.
+int run_fur_bench(const FurBenchOptions& options, std::ostream& log);
+
 }  // namespace lucent::render
