@@ -74,7 +74,7 @@ int run_fur_bench(const FurBenchOptions& options, std::ostream& log) {
   int rows = 0;
   for (const int shells : options.shells) {
    for (const float distance : options.distances) {
-    scene.camera = orbit_camera(scene.mesh, 30, 35, distance, options.width, options.height);
+    scene.camera = orbit_camera(scene.mesh, 30, 20, distance, options.width, options.height);
     fur::FurOptions fur;
     fur.texels = options.texels;
     fur.shells = shells;

@@ -26,10 +26,10 @@ struct RenderBenchOptions {
 /// Renders each mesh with each disc selection, one row each; returns the rows written.
 int run_render_bench(const RenderBenchOptions& options, std::ostream& log);
 
-/// `lucent bench fur`: the fur tile of seed 001 at the seed's 1280 x 1024 (its Table 1: 40 fps on
+/// `lucent bench fur`: the fur tile of seed 001 at the seed's 1280 x 1024 (the seed: 40 fps on
 /// a GeForce 6800 SLI), one row per shell count: the CPU precompute (hairs, cross-sections,
 /// transfer) and the per-frame draw (glFinish and a wall clock; the median of `frames` after a
-/// first, compiling frame), from the render command's default view (the tile on part of the
+/// first, compiling frame), from the render command's default view (30, 20: the tile on part of the
 /// frame) and from close by (the frame filled), with the fraction of pixels the fur covers.
 struct FurBenchOptions {
   std::filesystem::path out_csv = "notebooks_data/bench/fur.csv";
