@@ -206,6 +206,11 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
       ->capture_default_str();
   cmd->add_option("--fur-seed", args->fur.seed, "fur: the hair generator's seed")
       ->capture_default_str();
+  cmd->add_option("--fur-coverage", args->fur_coverage,
+                  "fur: a hair's cross-section over the texels: exact (the disc's overlap with "
+                  "each texel) or seed (its chord and wedge approximations, eqs. 1-2: the wedge "
+                  "is 13-32% off once a disc leaves the texel corner)")
+      ->capture_default_str();
   cmd->add_option("--fur-coat", args->fur_coat,
                   "on: a fur coat over the skin (an extension of seed 001): its transmittance "
                   "T(cos theta), from the --fur-* hairs, attenuates the light entering the skin "
@@ -343,6 +348,11 @@ SceneSetup build_scene(SceneArguments& args) {
     throw Error("--fur-coat: the sh technique's precomputed transfer has no fur coat; use maps, "
                 "hierarchical or reference");
   }
+  if (args.fur_coverage != "exact" && args.fur_coverage != "seed") {
+    throw Error("--fur-coverage: expected exact or seed, got '" + args.fur_coverage + "'");
+  }
+  args.fur.coverage = args.fur_coverage == "seed" ? render::fur::CoverageRule::kSeed
+                                                  : render::fur::CoverageRule::kExact;
   if (args.technique == "fur" || args.fur_coat == "on") {
     // Hair counts follow the tile's area (the seed's density at 64 x 64 texels).
     const double scale = double(args.fur.texels) * args.fur.texels / (64.0 * 64.0);

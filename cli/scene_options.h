@@ -47,6 +47,7 @@ struct SceneArguments {
   render::hbe::Options hbe;        ///< --technique hierarchical: oracle, form factor, mode
   render::fur::FurOptions fur;     ///< --technique fur: the tile; --fur-coat: the coat's hairs
   std::string fur_coat = "off";    ///< --fur-coat on|off: a fur coat over the skin (fur_coat.h)
+  std::string fur_coverage = "exact";  ///< --fur-coverage exact|seed: the hairs' cross-sections
   std::string hbe_mode = "render", hbe_rule = "gauss2", hbe_dipole = "chord";
 };
 

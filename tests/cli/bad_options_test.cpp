@@ -58,6 +58,7 @@ std::vector<BadCase> option_cases() {
       {"render_seed_word", nullptr, ren + "--seed abc", "--seed"},
       {"render_view_far", nullptr, ren + "--view 0,0,1e20", "--view"},
       {"render_view_two_numbers", nullptr, ren + "--view 0,0", "--view"},
+      {"render_fur_coverage_foo", nullptr, ren + "--fur-coverage foo", "--fur-coverage"},
       {"render_size_zero", nullptr, ren.substr(0, ren.find("--size")) + "--size 0x0 -o {dir}/r.exr",
        "--size"},
       {"render_object_size_huge", nullptr, ren + "--object-size-mm 1e308", "--object-size-mm"},
