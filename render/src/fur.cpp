@@ -219,6 +219,62 @@ double transmittance(const FurTile& tile, int s, int y, int x, const Eigen::Vect
   return std::exp(-tau);
 }
 
+namespace {
+
+// The shells' density repeated 2 x 2, so that a shift of up to n texels reads without wrapping.
+std::vector<float> padded_density(const FurTile& tile) {
+  const int n = tile.texels, N = 2 * n;
+  std::vector<float> padded(std::size_t(tile.shells) * N * N);
+  for (int l = 0; l < tile.shells; ++l)
+    for (int y = 0; y < N; ++y)
+      for (int x = 0; x < N; ++x)
+        padded[(std::size_t(l) * N + y) * N + x] = tile.at(l, y % n, x % n);
+  return padded;
+}
+
+std::vector<double> march_shell(const FurTile& tile, const std::vector<float>& padded, int s,
+                                const Eigen::Vector3d& d, double optical_density) {
+  const int n = tile.texels, N = 2 * n;
+  std::vector<double> tau(std::size_t(n) * n, 0.0);
+  if (!(d.z() > 0)) return tau;  // into the skin: T = 0 below
+  const double top = tile.shells * tile.shell_spacing, z0 = (s + 0.5) * tile.shell_spacing;
+  const double length = (top - z0) / d.z();
+  const int steps = std::max(1, int(std::ceil(length)));  // one texel per step, as `transmittance`
+  const double dt = length / steps;
+  for (int k = 0; k < steps; ++k) {
+    const double t = (k + 0.5) * dt;
+    // u = x + t d.x for voxel x: the integer part shifts, the fraction is the shell's.
+    const double au = t * d.x(), av = t * d.y();
+    const double fu0 = std::floor(au), fv0 = std::floor(av);
+    const double fu = au - fu0, fv = av - fv0;
+    const int ou = wrap(int(fu0), n), ov = wrap(int(fv0), n);
+    const double w = std::clamp((z0 + t * d.z()) / tile.shell_spacing - 0.5, 0.0, tile.shells - 1.0);
+    const int iw = std::min(int(std::floor(w)), tile.shells - 1), iw1 = std::min(iw + 1, tile.shells - 1);
+    const double fw = w - iw, scale = optical_density * dt;
+    const double w00 = (1 - fu) * (1 - fv), w10 = fu * (1 - fv), w01 = (1 - fu) * fv, w11 = fu * fv;
+    const float* lo = &padded[std::size_t(iw) * N * N];
+    const float* hi = &padded[std::size_t(iw1) * N * N];
+    for (int y = 0; y < n; ++y) {
+      const std::size_t r0 = std::size_t(y + ov) * N + ou, r1 = r0 + N;
+      double* out = &tau[std::size_t(y) * n];
+      for (int x = 0; x < n; ++x) {
+        const double a = w00 * lo[r0 + x] + w10 * lo[r0 + x + 1] + w01 * lo[r1 + x] + w11 * lo[r1 + x + 1];
+        const double b = w00 * hi[r0 + x] + w10 * hi[r0 + x + 1] + w01 * hi[r1 + x] + w11 * hi[r1 + x + 1];
+        out[x] += scale * ((1 - fw) * a + fw * b);
+      }
+    }
+  }
+  for (double& v : tau) v = v > 40 ? 0.0 : std::exp(-v);  // T < 4e-18 is 0, as `transmittance`
+  return tau;
+}
+
+}  // namespace
+
+std::vector<double> shell_transmittance(const FurTile& tile, int s, const Eigen::Vector3d& d,
+                                        double optical_density) {
+  return march_shell(tile, padded_density(tile), s, d, optical_density);
+}
+
 void compute_transfer(FurTile& tile, const FurOptions& o, int threads) {
   const ShQuadrature rule = sh_quadrature(o.quadrature_nodes);
   std::vector<ShVector<double>> Y;
@@ -230,22 +286,24 @@ void compute_transfer(FurTile& tile, const FurOptions& o, int threads) {
   const int n = tile.texels;
   tile.transfer.assign(tile.density.size() * kShCoefficients, 0.0f);
   if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+  const std::vector<float> padded = padded_density(tile);
   std::atomic<int> next{0};
   const auto work = [&] {
+    std::vector<double> t(std::size_t(n) * n * kShCoefficients);
     for (int s; (s = next.fetch_add(1)) < tile.shells;) {
-      for (int y = 0; y < n; ++y) {
-        for (int x = 0; x < n; ++x) {
-          ShVector<double> t{};
-          for (std::size_t k : upper) {
-            const double T = rule.weights[k] * transmittance(tile, s, y, x, rule.directions[k],
-                                                             o.optical_density);
-            if (T == 0) continue;
-            for (int i = 0; i < kShCoefficients; ++i) t[std::size_t(i)] += T * Y[k][std::size_t(i)];
-          }
-          float* out = &tile.transfer[((std::size_t(s) * n + y) * n + x) * kShCoefficients];
-          for (int i = 0; i < kShCoefficients; ++i) out[i] = float(t[std::size_t(i)]);
+      std::fill(t.begin(), t.end(), 0.0);
+      for (std::size_t k : upper) {
+        const std::vector<double> T =
+            march_shell(tile, padded, s, rule.directions[k], o.optical_density);
+        for (std::size_t p = 0; p < T.size(); ++p) {
+          const double wT = rule.weights[k] * T[p];
+          if (wT == 0) continue;
+          double* out = &t[p * kShCoefficients];
+          for (int i = 0; i < kShCoefficients; ++i) out[i] += wT * Y[k][std::size_t(i)];
         }
       }
+      float* out = &tile.transfer[std::size_t(s) * n * n * kShCoefficients];
+      for (std::size_t i = 0; i < t.size(); ++i) out[i] = float(t[i]);
     }
   };
   std::vector<std::thread> pool;
@@ -261,6 +319,7 @@ FurCoat coat_transmittance(const FurTile& tile, double optical_density, int node
   const int n = tile.texels;
   FurCoat coat;
   coat.transmittance.assign(std::size_t(nodes), 0.0f);
+  const std::vector<float> padded = padded_density(tile);
   std::atomic<int> next{0};
   const auto work = [&] {
     for (int k; (k = next.fetch_add(1)) < nodes;) {
@@ -269,8 +328,7 @@ FurCoat coat_transmittance(const FurTile& tile, double optical_density, int node
       for (int j = 0; j < azimuths; ++j) {
         const double phi = 2 * kPi * (j + 0.5) / azimuths;
         const Eigen::Vector3d d(s * std::cos(phi), s * std::sin(phi), mu);
-        for (int y = 0; y < n; ++y)
-          for (int x = 0; x < n; ++x) sum += transmittance(tile, 0, y, x, d, optical_density);
+        for (const double T : march_shell(tile, padded, 0, d, optical_density)) sum += T;
       }
       coat.transmittance[std::size_t(k)] = float(sum / (double(azimuths) * n * n));
     }

@@ -30,6 +30,33 @@ TEST(FurLightSh, DirectionalLightIsItsDeltaInTheTileFrame) {
   for (int i = 0; i < kShCoefficients; ++i) EXPECT_NEAR(rect[1][std::size_t(i)], point[1][std::size_t(i)], 1e-9);
 }
 
+// Fur over a mesh evaluates the lights' SH in each vertex's frame; that is the rotation of the
+// world-frame coefficients (sh_rotate, the sampling method), for every light type, in any frame.
+TEST(FurLightSh, VertexFrameEqualsRotatingTheWorldFrameCoefficients) {
+  const std::vector<Light> lights = {parse_light("directional:0.3,1,-0.4:1,0.5,0.2"),
+                                     parse_light("point:40,80,-30:900,700,500"),
+                                     rect_light({-30, 60, 20}, {10, 0, 0}, {0, 3, -8}, {2, 2, 2})};
+  const Vec3f centre(5, 20, -3);
+  const auto world = fur_light_sh(lights, centre, Eigen::Matrix3d::Identity());
+  for (const Vec3f n : {Vec3f(0, 1, 0), Vec3f(0.6f, 0.0f, 0.8f), Vec3f(-0.2f, -0.9f, 0.3883f).normalized(),
+                        Vec3f(0, 0.99999f, 0.0045f).normalized()}) {
+    const Eigen::Matrix3d M = fur_vertex_frame(n);
+    EXPECT_NEAR((M * M.transpose() - Eigen::Matrix3d::Identity()).norm(), 0, 1e-12);
+    EXPECT_NEAR(M.determinant(), 1, 1e-12);  // a rotation, not a reflection
+    EXPECT_NEAR((M.row(2).transpose() - n.cast<double>()).norm(), 0, 1e-6);  // local z = n
+    const auto local = fur_light_sh(lights, centre, M);
+    for (int c = 0; c < 3; ++c) {
+      const auto turned = sh_rotate(world[std::size_t(c)], M);
+      double peak = 0;
+      for (double v : world[std::size_t(c)]) peak = std::max(peak, std::abs(v));
+      for (int i = 0; i < kShCoefficients; ++i) {
+        EXPECT_NEAR(local[std::size_t(c)][std::size_t(i)], turned[std::size_t(i)], 1e-9 * peak)
+            << "coefficient " << i << " channel " << c;
+      }
+    }
+  }
+}
+
 TEST(FurRenderer, TileIsFiniteNonBlackAndDeterministic) {
   setenv("MESA_SHADER_CACHE_DISABLE", "true", 0);
   std::string why;

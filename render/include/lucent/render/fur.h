@@ -103,6 +103,12 @@ FurTile rasterize_hairs(const std::vector<Hair>& hairs, const FurOptions& option
 double transmittance(const FurTile& tile, int s, int y, int x, const Eigen::Vector3d& d,
                      double optical_density);
 
+/// The same from the centre of every voxel of shell s at once, row-major [y][x] (`transmittance`
+/// to rounding). Voxel centres sit on integer offsets, so each march step's trilinear weights are
+/// shared by the whole shell: one weighted, shifted sum over a periodically padded copy per step.
+std::vector<double> shell_transmittance(const FurTile& tile, int s, const Eigen::Vector3d& d,
+                                        double optical_density);
+
 /// Fills tile.transfer (multi-threaded over shells).
 void compute_transfer(FurTile& tile, const FurOptions& options, int threads = 0);
 
