@@ -38,6 +38,7 @@
 #include "lucent/render/reference_renderer.h"
 #include "lucent/render/tone_map.h"
 #include "slab_scene.h"
+#include "gl_fixture.h"
 
 namespace lucent::render {
 namespace {
@@ -46,21 +47,9 @@ using materials::DiffusionModel;
 using V = Eigen::Vector3d;
 constexpr double kPi = std::numbers::pi;
 
-class AreaLightGlTest : public ::testing::Test {
+class AreaLightGlTest : public testing_gl::GlTest {
  protected:
-  static void SetUpTestSuite() {
-    setenv("MESA_SHADER_CACHE_DISABLE", "true", 0);
-    context_ = GlContext::try_create_headless(&why_not_).release();
-  }
-  static void TearDownTestSuite() {
-    delete context_;
-    context_ = nullptr;
-  }
-  static GlContext* context_;
-  static std::string why_not_;
 };
-GlContext* AreaLightGlTest::context_ = nullptr;
-std::string AreaLightGlTest::why_not_;
 
 // ---------------------------------------------------------------------------------------------
 // The GLSL twin.

@@ -25,6 +25,7 @@
 #include "lucent/materials/tabulated.h"
 #include "lucent/materials/transport_table.h"
 #include "lucent/render/gl_context.h"
+#include "gl_fixture.h"
 
 namespace lucent::render {
 namespace {
@@ -244,16 +245,8 @@ double float_rounding_sensitivity(const Config& c, double S, std::mt19937_64& rn
   return worst;
 }
 
-class GlslTwinTest : public ::testing::Test {
+class GlslTwinTest : public testing_gl::GlTest {
  protected:
-  static void SetUpTestSuite() {
-    setenv("MESA_SHADER_CACHE_DISABLE", "true", 0);
-    context_ = GlContext::try_create_headless(&why_not_).release();
-  }
-  static void TearDownTestSuite() {
-    delete context_;
-    context_ = nullptr;
-  }
   void SetUp() override {
     if (context_ == nullptr) GTEST_SKIP() << "no headless OpenGL: " << why_not_;
   }
@@ -292,12 +285,8 @@ class GlslTwinTest : public ::testing::Test {
     return result;
   }
 
-  static GlContext* context_;
-  static std::string why_not_;
 };
 
-GlContext* GlslTwinTest::context_ = nullptr;
-std::string GlslTwinTest::why_not_;
 
 TEST_F(GlslTwinTest, DirectionalDipoleMatchesDoubleModel) {
   constexpr int kConfigs = 20000;

@@ -16,20 +16,13 @@
 #include "lucent/render/image_compare.h"
 #include "lucent/render/reference_renderer.h"
 #include "lucent/render/scene.h"
+#include "gl_fixture.h"
 
 namespace lucent::render {
 namespace {
 
-class HierarchicalRendererTest : public ::testing::Test {
+class HierarchicalRendererTest : public testing_gl::GlTest {
  protected:
-  static void SetUpTestSuite() {
-    setenv("MESA_SHADER_CACHE_DISABLE", "true", 0);
-    context_ = GlContext::try_create_headless(&why_not_).release();
-  }
-  static void TearDownTestSuite() {
-    delete context_;
-    context_ = nullptr;
-  }
   void SetUp() override {
     if (context_ == nullptr) GTEST_SKIP() << "no headless OpenGL: " << why_not_;
     context_->make_current();  // render_hierarchical's own context replaced it
@@ -45,11 +38,7 @@ class HierarchicalRendererTest : public ::testing::Test {
     scene.specular = false;
     return scene;
   }
-  static GlContext* context_;
-  static std::string why_not_;
 };
-GlContext* HierarchicalRendererTest::context_ = nullptr;
-std::string HierarchicalRendererTest::why_not_;
 
 // The check: a lit potato sphere within 10% relative RMSE of the reference. Measured at
 // 48 px: potato 1.8%, marble 1.4% (means within 0.9%); the reference's own noise at 1024 probes is ~1.5% (its note), so

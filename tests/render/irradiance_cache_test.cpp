@@ -15,6 +15,7 @@
 #include "lucent/render/image_compare.h"
 #include "lucent/render/reference_renderer.h"
 #include "lucent/render/scene.h"
+#include "slab_scene.h"
 
 namespace lucent::render::detail {
 namespace {
@@ -90,26 +91,8 @@ TEST(IrradianceCache, ConvergesToDirectEvaluationOnASphere) {
 // Two boxes on a floor under a rect: the tall one casts a soft shadow on the floor.
 Mesh boxes() {
   Mesh m;
-  const auto box = [&m](Vec3f lo, Vec3f hi) {
-    const auto quad = [&m](Vec3f n, Vec3f a, Vec3f b, Vec3f c, Vec3f d) {
-      const unsigned base = unsigned(m.positions.size());
-      for (const Vec3f& p : {a, b, c, d}) {
-        m.positions.push_back(p);
-        m.normals.push_back(n);
-      }
-      m.triangles.push_back({base, base + 1, base + 2});
-      m.triangles.push_back({base, base + 2, base + 3});
-    };
-    const float x0 = lo.x(), y0 = lo.y(), z0 = lo.z(), x1 = hi.x(), y1 = hi.y(), z1 = hi.z();
-    quad({0, 1, 0}, {x0, y1, z0}, {x0, y1, z1}, {x1, y1, z1}, {x1, y1, z0});
-    quad({0, -1, 0}, {x0, y0, z0}, {x1, y0, z0}, {x1, y0, z1}, {x0, y0, z1});
-    quad({1, 0, 0}, {x1, y0, z0}, {x1, y1, z0}, {x1, y1, z1}, {x1, y0, z1});
-    quad({-1, 0, 0}, {x0, y0, z0}, {x0, y0, z1}, {x0, y1, z1}, {x0, y1, z0});
-    quad({0, 0, 1}, {x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1});
-    quad({0, 0, -1}, {x0, y0, z0}, {x0, y1, z0}, {x1, y1, z0}, {x1, y0, z0});
-  };
-  box({-60, -5, -60}, {60, 0, 60});  // the floor slab
-  box({-10, 0, -10}, {10, 40, 10});  // the tall box
+  testing_slab::add_box(m, {-60, -5, -60}, {60, 0, 60});  // the floor slab
+  testing_slab::add_box(m, {-10, 0, -10}, {10, 40, 10});  // the tall box
   return m;
 }
 

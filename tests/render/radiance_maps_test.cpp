@@ -28,6 +28,7 @@
 #include "lucent/render/radiance_maps.h"
 #include "lucent/render/reference_renderer.h"
 #include "radiance_maps_sampling.h"
+#include "gl_fixture.h"
 
 namespace lucent::render {
 namespace {
@@ -135,16 +136,11 @@ TEST(RadianceMapSampling, FittedCamerasContainTheBoundingSphere) {
 
 // ---- OpenGL pipeline --------------------------------------------------------------------------
 
-class RadianceMapsTest : public ::testing::Test {
+class RadianceMapsTest : public testing_gl::GlTest {
  protected:
   static void SetUpTestSuite() {
-    setenv("MESA_SHADER_CACHE_DISABLE", "true", 0);
-    context_ = GlContext::try_create_headless(&why_not_).release();
+    GlTest::SetUpTestSuite();
     if (context_ != nullptr) std::printf("OpenGL: %s\n", context_->describe().c_str());
-  }
-  static void TearDownTestSuite() {
-    delete context_;
-    context_ = nullptr;
   }
   void SetUp() override {
     if (context_ == nullptr) GTEST_SKIP() << "no headless OpenGL: " << why_not_;
@@ -171,12 +167,8 @@ class RadianceMapsTest : public ::testing::Test {
     return s;
   }
 
-  static GlContext* context_;
-  static std::string why_not_;
 };
 
-GlContext* RadianceMapsTest::context_ = nullptr;
-std::string RadianceMapsTest::why_not_;
 
 double mean_over(const ImageRgb& image, const std::vector<std::uint8_t>& mask, int x0, int x1) {
   double sum = 0;

@@ -22,22 +22,15 @@
 #include "lucent/render/scene.h"
 #include "lucent/render/sh_renderer.h"
 #include "lucent/render/sh_translucency.h"
+#include "gl_fixture.h"
 
 namespace lucent::render {
 namespace {
 
 using Vec3d = Eigen::Vector3d;
 
-class ShRendererTest : public ::testing::Test {
+class ShRendererTest : public testing_gl::GlTest {
  protected:
-  static void SetUpTestSuite() {
-    setenv("MESA_SHADER_CACHE_DISABLE", "true", 0);
-    context_ = GlContext::try_create_headless(&why_not_).release();
-  }
-  static void TearDownTestSuite() {
-    delete context_;
-    context_ = nullptr;
-  }
   void SetUp() override {
     if (context_ == nullptr) GTEST_SKIP() << "no headless OpenGL: " << why_not_;
   }
@@ -54,12 +47,8 @@ class ShRendererTest : public ::testing::Test {
     return scene;
   }
 
-  static GlContext* context_;
-  static std::string why_not_;
 };
 
-GlContext* ShRendererTest::context_ = nullptr;
-std::string ShRendererTest::why_not_;
 
 // ---- the GLSL twin ----------------------------------------------------------------------------
 

@@ -33,6 +33,27 @@ double face_integral(F&& f, double h) {
   return sum * step + f(lo) * std::numbers::pi * lo * lo;
 }
 
+/// Appends the axis-aligned box [lo, hi] to m: 6 faces of 2 triangles, 4 vertices each with the
+/// face's outward normal (sharp edges), counter-clockwise seen from outside.
+inline void add_box(Mesh& m, const Vec3f& lo, const Vec3f& hi) {
+  const auto quad = [&m](Vec3f n, Vec3f a, Vec3f b, Vec3f c, Vec3f d) {
+    const unsigned base = unsigned(m.positions.size());
+    for (const Vec3f& p : {a, b, c, d}) {
+      m.positions.push_back(p);
+      m.normals.push_back(n);
+    }
+    m.triangles.push_back({base, base + 1, base + 2});
+    m.triangles.push_back({base, base + 2, base + 3});
+  };
+  const float x0 = lo.x(), y0 = lo.y(), z0 = lo.z(), x1 = hi.x(), y1 = hi.y(), z1 = hi.z();
+  quad({0, 1, 0}, {x0, y1, z0}, {x0, y1, z1}, {x1, y1, z1}, {x1, y1, z0});
+  quad({0, -1, 0}, {x0, y0, z0}, {x1, y0, z0}, {x1, y0, z1}, {x0, y0, z1});
+  quad({1, 0, 0}, {x1, y0, z0}, {x1, y1, z0}, {x1, y1, z1}, {x1, y0, z1});
+  quad({-1, 0, 0}, {x0, y0, z0}, {x0, y0, z1}, {x0, y1, z1}, {x0, y1, z0});
+  quad({0, 0, 1}, {x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1});
+  quad({0, 0, -1}, {x0, y0, z0}, {x0, y1, z0}, {x1, y1, z0}, {x1, y0, z0});
+}
+
 struct SlabScene {
   Scene scene;
   double half_width_mm = 100;  // of the lit face
@@ -46,22 +67,8 @@ inline SlabScene make_slab_scene(const std::string& material, int pixels, double
   s.half_width_mm = h;
   Mesh& m = s.scene.mesh;
   m.name = "slab";
-  const float x = float(h), y = 25.0f, z = float(h);
-  const auto quad = [&m](Vec3f n, Vec3f a, Vec3f b, Vec3f c, Vec3f d) {
-    const unsigned base = unsigned(m.positions.size());
-    for (const Vec3f& p : {a, b, c, d}) {
-      m.positions.push_back(p);
-      m.normals.push_back(n);
-    }
-    m.triangles.push_back({base, base + 1, base + 2});
-    m.triangles.push_back({base, base + 2, base + 3});
-  };
-  quad({0, 1, 0}, {-x, y, -z}, {-x, y, z}, {x, y, z}, {x, y, -z});
-  quad({0, -1, 0}, {-x, -y, -z}, {x, -y, -z}, {x, -y, z}, {-x, -y, z});
-  quad({1, 0, 0}, {x, -y, -z}, {x, y, -z}, {x, y, z}, {x, -y, z});
-  quad({-1, 0, 0}, {-x, -y, -z}, {-x, -y, z}, {-x, y, z}, {-x, y, -z});
-  quad({0, 0, 1}, {-x, -y, z}, {x, -y, z}, {x, y, z}, {-x, y, z});
-  quad({0, 0, -1}, {-x, -y, -z}, {-x, y, -z}, {x, y, -z}, {x, -y, -z});
+  const float y = 25.0f;  // the lit face
+  add_box(m, Vec3f(-float(h), -y, -float(h)), Vec3f(float(h), y, float(h)));
   s.scene.material = materials::load_material(material);
   s.scene.lights = {parse_light("directional:0,1,0:1,1,1")};
   s.scene.specular = false;  // the closed form is the subsurface term (the mirror highlight sits

@@ -28,27 +28,16 @@
 #include "lucent/render/radiance_maps.h"
 #include "lucent/render/reference_renderer.h"
 #include "slab_scene.h"
+#include "gl_fixture.h"
 
 namespace lucent::render {
 namespace {
 
 using materials::DiffusionModel;
 
-class SlabTruthTest : public ::testing::Test {
+class SlabTruthTest : public testing_gl::GlTest {
  protected:
-  static void SetUpTestSuite() {
-    setenv("MESA_SHADER_CACHE_DISABLE", "true", 0);
-    context_ = GlContext::try_create_headless(&why_not_).release();
-  }
-  static void TearDownTestSuite() {
-    delete context_;
-    context_ = nullptr;
-  }
-  static GlContext* context_;
-  static std::string why_not_;
 };
-GlContext* SlabTruthTest::context_ = nullptr;
-std::string SlabTruthTest::why_not_;
 
 TEST(SlabClosedForm, QuadratureOfTheDipoleMatchesItsTotalDiffuseReflectance) {
   // The yardstick itself: over a face far wider than the tail, the quadrature of R_d is the
