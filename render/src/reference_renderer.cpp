@@ -291,34 +291,6 @@ double subsurface_cutoff_mm(const materials::Medium<double>& medium, DiffusionMo
   return kInf;
 }
 
-double masked_rmse(const ImageRgb& a, const ImageRgb& b, const std::vector<std::uint8_t>& mask) {
-  if (a.width != b.width || a.height != b.height) {
-    throw Error("masked_rmse: images differ in size");
-  }
-  double sum = 0;
-  std::size_t count = 0;
-  for (std::size_t p = 0; p < mask.size(); ++p) {
-    if (!mask[p]) continue;
-    for (int c = 0; c < 3; ++c) {
-      const double d = double(a.data[3 * p + c]) - b.data[3 * p + c];
-      sum += d * d;
-      ++count;
-    }
-  }
-  return count ? std::sqrt(sum / count) : 0.0;
-}
-
-double masked_mean(const ImageRgb& image, const std::vector<std::uint8_t>& mask) {
-  double sum = 0;
-  std::size_t count = 0;
-  for (std::size_t p = 0; p < mask.size(); ++p) {
-    if (!mask[p]) continue;
-    for (int c = 0; c < 3; ++c) sum += image.data[3 * p + c];
-    count += 3;
-  }
-  return count ? sum / count : 0.0;
-}
-
 ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
                                 const ReferenceOptions& options) {
   const auto start = Clock::now();

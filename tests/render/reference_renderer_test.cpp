@@ -17,6 +17,7 @@
 #include "lucent/imaging/image_io.h"
 #include "lucent/materials/error.h"
 #include "lucent/materials/material.h"
+#include "lucent/render/image_compare.h"
 #include "lucent/render/reference_renderer.h"
 
 namespace lucent::render {

@@ -20,6 +20,12 @@ struct ImageDifference {
   std::string to_string() const;
 };
 
+/// Root-mean-square difference over the pixels where mask != 0, all three channels.
+double masked_rmse(const ImageRgb& a, const ImageRgb& b, const std::vector<std::uint8_t>& mask);
+
+/// Mean over the pixels where mask != 0, all three channels.
+double masked_mean(const ImageRgb& image, const std::vector<std::uint8_t>& mask);
+
 /// Pixels where the reference is non-zero in some channel (a black background is not the object).
 std::vector<std::uint8_t> nonzero_mask(const ImageRgb& reference);
 

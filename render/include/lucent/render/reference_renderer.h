@@ -100,10 +100,4 @@ ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
 double subsurface_cutoff_mm(const materials::Medium<double>& medium, DiffusionModel model,
                             double tolerance = 1e-4);
 
-/// Root-mean-square difference over the pixels where mask != 0, all three channels.
-double masked_rmse(const ImageRgb& a, const ImageRgb& b, const std::vector<std::uint8_t>& mask);
-
-/// Mean over the pixels where mask != 0, all three channels.
-double masked_mean(const ImageRgb& image, const std::vector<std::uint8_t>& mask);
-
 }  // namespace lucent::render
