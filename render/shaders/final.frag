@@ -129,7 +129,10 @@ void main() {
   vec3 w_o = normalize(u_eye - x_o);
   float F_r = fresnel_reflectance(dot(n_o, w_o), u_eta);
   vec3 L = (1.0 - F_r) * L_ss;
-  if (u_has_environment) L += F_r * environment_lookup(u_environment, reflect(-w_o, n_o));
+  // The mirror direction's light crosses a fur coat too (cos_i = cos_o there; T = 1 without one).
+  if (u_has_environment) {
+    L += F_r * fur_coat(dot(n_o, w_o)) * environment_lookup(u_environment, reflect(-w_o, n_o));
+  }
   L += specular_lights(x_o, n_o, w_o);
   out_color = vec4(L, seen > 0.0 ? 1.0 : 0.5);
 }

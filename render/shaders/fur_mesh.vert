@@ -31,7 +31,9 @@ void main() {
   vec3 n = normalize(load(1, v));
   f_shell = gl_InstanceID;
   float offset = u_depth_only ? 0.0 : (float(gl_InstanceID) + 0.5) * u_spacing_mm;
-  f_position = load(0, v) + offset * n;
+  // f_position is the surface point under the shell: every shell reads the tile at the same uv
+  // (the pushed-out point would slide the texture along oblique faces, shell by shell).
+  f_position = load(0, v);
   f_normal = n;
-  gl_Position = u_view_proj * vec4(f_position, 1.0);
+  gl_Position = u_view_proj * vec4(f_position + offset * n, 1.0);
 }

@@ -35,7 +35,10 @@ void main() {
   float cos_o = dot(n_o, w_o);
   float F_r = fresnel_reflectance(cos_o, u_eta);
   vec3 L = (1.0 - F_r) / kPi * max(f_B, vec3(0.0));
-  if (u_has_environment) L += F_r * environment_lookup(u_environment, reflect(-w_o, n_o));
+  // The mirror direction's light crosses a fur coat too (cos_i = cos_o there; T = 1 without one).
+  if (u_has_environment) {
+    L += F_r * fur_coat(cos_o) * environment_lookup(u_environment, reflect(-w_o, n_o));
+  }
   if (u_specular && u_roughness > 0.0 && cos_o > 0.0) {
     for (int l = 0; l < u_light_count; ++l) {
       vec4 p = u_light_position[l];

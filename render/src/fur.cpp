@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <string>
 #include <thread>
 
 #include "lucent/materials/error.h"
@@ -55,6 +56,12 @@ void FurOptions::validate() const {
   if (quadrature_nodes < 3 || quadrature_nodes > 256) throw Error("fur: quadrature nodes 3..256");
   if (!(tile_mm > 0) || !(height_mm > 0) || !(tile_mm <= 1e4) || !(height_mm <= 1e4)) {
     throw Error("--fur-tile-mm, --fur-height-mm: expected lengths in (0, 1e4] mm");
+  }
+  // Over a mesh the coat is height_mm / tile_mm * texels texels tall, and its march that long.
+  if (height_mm / tile_mm * texels > 1024) {
+    throw Error("--fur-height-mm, --fur-tile-mm: the coat is " +
+                std::to_string(height_mm / tile_mm * texels) +
+                " texels tall (height / tile width x --fur-texels); expected at most 1024");
   }
 }
 
@@ -194,7 +201,8 @@ double transmittance(const FurTile& tile, int s, int y, int x, const Eigen::Vect
   const double top = tile.shells * tile.shell_spacing;
   const Eigen::Vector3d p(x + 0.5, y + 0.5, (s + 0.5) * tile.shell_spacing);
   const double length = (top - p.z()) / d.z();
-  const int steps = std::max(1, int(std::ceil(length)));  // one texel per step
+  // One texel per step; at most 1e6 (grazing paths, cos theta < 1e-3 of 1024 texels: coarser).
+  const int steps = int(std::clamp(std::ceil(length), 1.0, 1e6));
   const double dt = length / steps;
   const auto density = [&](const Eigen::Vector3d& q) {
     // Trilinear between voxel centres, periodic in x and y, clamped in z.
@@ -239,7 +247,7 @@ std::vector<double> march_shell(const FurTile& tile, const std::vector<float>& p
   if (!(d.z() > 0)) return tau;  // into the skin: T = 0 below
   const double top = tile.shells * tile.shell_spacing, z0 = (s + 0.5) * tile.shell_spacing;
   const double length = (top - z0) / d.z();
-  const int steps = std::max(1, int(std::ceil(length)));  // one texel per step, as `transmittance`
+  const int steps = int(std::clamp(std::ceil(length), 1.0, 1e6));  // as `transmittance`
   const double dt = length / steps;
   for (int k = 0; k < steps; ++k) {
     const double t = (k + 0.5) * dt;

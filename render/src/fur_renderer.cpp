@@ -36,6 +36,16 @@ gl::Texture upload_fur_transfer(const fur::FurTile& tile) {
       }
     }
   }
+  GLint max_layers = 0, max_size = 0;
+  glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+  if (7 * S > max_layers || n > max_size) {
+    throw Error("--fur-shells, --fur-texels: " + std::to_string(S) + " shells need " +
+                std::to_string(7 * S) + " texture layers of " + std::to_string(n) + "^2 texels; " +
+                "this OpenGL allows " + std::to_string(max_layers) + " layers of at most " +
+                std::to_string(max_size) + "^2 (at most " + std::to_string(max_layers / 7) +
+                " shells)");
+  }
   gl::Texture transfer = gl::create_texture(GL_TEXTURE_2D_ARRAY);
   glTextureStorage3D(transfer.id(), 1, GL_RGBA32F, n, n, 7 * S);
   glTextureSubImage3D(transfer.id(), 0, 0, 0, 0, n, n, 7 * S, GL_RGBA, GL_FLOAT, layers.data());

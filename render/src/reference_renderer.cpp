@@ -535,7 +535,11 @@ ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
       const PixelHit& hit = hits[p];
       Vec3f reflection = Vec3f::Zero();
       if (options.environment_reflection && environment) {
-        reflection = float(hit.fresnel_reflect) * environment_lookup(*environment, hit.reflected);
+        // Under a fur coat the mirror direction's light crosses it too (cos_i = cos_o there).
+        const double coat =
+            scene.fur_coat ? scene.fur_coat->at(double(hit.n_o.dot(hit.w_o))) : 1.0;
+        reflection =
+            float(hit.fresnel_reflect * coat) * environment_lookup(*environment, hit.reflected);
       }
       const Vec3f specular = specular_radiance(
           scene, rays, hit, eps, mix(options.seed ^ (std::uint64_t(pass) << 40) ^ std::uint64_t(p)));

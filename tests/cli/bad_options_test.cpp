@@ -59,6 +59,9 @@ std::vector<BadCase> option_cases() {
       {"render_view_far", nullptr, ren + "--view 0,0,1e20", "--view"},
       {"render_view_two_numbers", nullptr, ren + "--view 0,0", "--view"},
       {"render_fur_coverage_foo", nullptr, ren + "--fur-coverage foo", "--fur-coverage"},
+      // A coat 96 000 texels tall (1.5 mm over a 0.001 mm tile of 64 texels): hours of marching.
+      {"render_fur_coat_too_tall", nullptr, ren + "--fur-coat on --fur-tile-mm 0.001",
+       "--fur-height-mm"},
       {"render_size_zero", nullptr, ren.substr(0, ren.find("--size")) + "--size 0x0 -o {dir}/r.exr",
        "--size"},
       {"render_object_size_huge", nullptr, ren + "--object-size-mm 1e308", "--object-size-mm"},

@@ -26,6 +26,7 @@ struct FurCoat {
   template <typename T>
   T at(T mu) const {
     const int n = int(transmittance.size());
+    if (n < 2) return n == 1 ? T(transmittance[0]) : T(1);  // not a table: a constant, or no coat
     if (!(mu > T(0))) return T(0);
     if (mu >= T(1)) return T(transmittance[std::size_t(n - 1)]);
     int k = int(mu * T(n)) - 1;  // mu_k <= mu < mu_k+1
