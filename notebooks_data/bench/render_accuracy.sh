@@ -57,7 +57,7 @@ PY
 
 light=(--directions 8 --radiance-map 256 --light-map 256 --samples 32 --disc-points 256)
 if [[ "$mode" == accuracy ]]; then
-  for mesh in sphere dragon:4; do
+  for mesh in ${MESHES:-sphere dragon:4}; do
     for material in marble potato skin1; do
       for model in dipole ddipole tabulated; do
         run_case light "$mesh" "$material" "$model" 64 1,2,4,8,16,32,64 "${light[@]}"
@@ -74,6 +74,9 @@ else
   for mesh in sphere dragon:4; do
     run_case default "$mesh" marble ddipole 32 1,2,4,8,16,32
   done
+  run_case default dragon:4 potato ddipole 32 1,2,4,8,16,32
+  run_case default dragon:4 skin1 ddipole 32 1,2,4,8,16,32
+  run_case default dragon:4 marble tabulated 32 1,2,4,8,16,32
 fi
 mv "$tmp" "$csv"
 echo "wrote $csv" >&2

@@ -15,13 +15,21 @@ flat in int v_layer[];
 
 out vec3 g_position;
 out vec3 g_normal;
+// The triangle's own (flat) normal, turned to the side of its vertex normals: the plane the
+// triangle's points lie in, where the interpolated normal is only a shading normal.
+flat out vec3 g_face_normal;
 flat out int g_layer;
 
 invariant gl_Position;
 
 void emit_layered_triangle(mat4 view_proj) {
   int layer = v_layer[0];
+  vec3 face = cross(v_position[1] - v_position[0], v_position[2] - v_position[0]);
+  if (dot(face, v_normal[0] + v_normal[1] + v_normal[2]) < 0.0) face = -face;
+  float face_length = length(face);
+  vec3 face_normal = face_length > 0.0 ? face / face_length : normalize(v_normal[0]);
   for (int k = 0; k < 3; ++k) {
+    g_face_normal = face_normal;
     gl_Layer = layer;
     g_layer = layer;
     g_position = v_position[k];

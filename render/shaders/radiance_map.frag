@@ -8,9 +8,11 @@
 // plane through x_o perpendicular to w_d (toward the light), rotated per texel and per frame
 // (theta_t = 2 pi (random(texel, layer) + t / T), seed §5.4.1); each rotated point is projected into
 // the light map, whose texel there holds the surface point x_i nearest to the light on that ray
-// (position, normal). w_i (mm^2) is the sample's share of the disc area with the exponential bias
-// undone, A_c e^(sigma* r_i) / sum_j e^(sigma* r_j) (see radiance_maps_sampling.h), so the n_i . w_l
-// of the irradiance and the 1 / (n_i . w_l) of the projected area cancel (seed eq. 4.2).
+// (position, shading normal n_i, the normal g_i of its triangle). w_i (mm^2) is the sample's share
+// of the disc area with the exponential bias undone, A_c e^(sigma* r_i) / sum_j e^(sigma* r_j)
+// (see radiance_maps_sampling.h), so the cosine of the irradiance and the 1 / cos of the projected
+// area cancel (seed eq. 4.2) where n_i = g_i; on a faceted mesh their ratio
+// (n_i . w_l) / (g_i . w_l) is left (the reference's irradiance is the shading normal's).
 //   directional light: E_l = the light's irradiance on a surface facing it;
 //   point light: E_l = I (w_i . w_d) / |x_l - d_i|^2, exact for the solid angle the disc element
 //   subtends (the seed's I / |x_l - x_i|^2 assumes the disc at the surface).
@@ -57,6 +59,7 @@ layout(std140, binding = 2) uniform DiscSamples {
 
 uniform sampler2DArray u_light_positions;  // xyz mm, w coverage
 uniform sampler2DArray u_light_normals;
+uniform sampler2DArray u_light_face_normals;  // the triangle's plane under each texel
 uniform sampler2DArray u_previous;         // sum up to the previous frame (other ping-pong buffer)
 uniform bool u_has_previous;
 uniform bool u_depth_only;                 // depth pre-pass: no gathering
@@ -139,16 +142,21 @@ void main() {
       vec3 n_i = texelFetch(u_light_normals, at, 0).xyz;
       // The texel holds the surface point at its centre; the disc point's own ray (along w_d, or
       // from the point light through x_d) meets the surface elsewhere in the texel. Intersecting
-      // that ray with the texel's tangent plane puts x_i where the sample's weight says it is,
-      // at any light-map resolution (texels larger than a mean free path otherwise move every
-      // near sample by up to half a texel, which biases the sum by the profile's curvature).
+      // that ray with the plane of the triangle under the texel's centre puts x_i where the
+      // sample's weight says it is, at any light-map resolution (texels larger than a mean free
+      // path otherwise move every near sample by up to half a texel, which biases the sum by the
+      // profile's curvature). The triangle's plane, not the shading normal's: on a faceted mesh
+      // the interpolated normal tilts that plane off the surface by degrees, so near samples
+      // landed a texel x tan(tilt) above or below it; on dragon:4 that took 6-26% off a material
+      // whose mean free path is 0.01-0.05 mm (dense.json in the truth tests) and 2% off marble.
       // Kept to a few texels along the ray, so grazing texels fall back to their centre.
+      vec3 n_plane = texelFetch(u_light_face_normals, at, 0).xyz;
       vec3 origin = is_point ? light.xyz : x_d;
       vec3 ray = is_point ? normalize(x_d - light.xyz) : -w_d;
-      float along = dot(n_i, ray);
+      float along = dot(n_plane, ray);
       vec3 x_i = p.xyz;
       if (along < -0.05) {
-        float s = dot(p.xyz - origin, n_i) / along;
+        float s = dot(p.xyz - origin, n_plane) / along;
         vec3 hit = origin + s * ray;
         float texel = u_light_texel_mm[l].x + u_light_texel_mm[l].y * distance(origin, p.xyz);
         if (distance(hit, p.xyz) <= 4.0 * texel) x_i = hit;
@@ -161,7 +169,9 @@ void main() {
         FormFactor ff = area_form_factor(slot, x_i, n_i);
         vec3 to_s = light.xyz - x_i;
         float d_s = length(to_s);
-        float cos_s = d_s > 0.0 ? dot(n_i, to_s) / d_s : 0.0;
+        // The disc maps onto the triangle's plane (the light map's projection from s_t), so
+        // the mapping's cos_s is the triangle's; the irradiance pi L F is the shading normal's.
+        float cos_s = d_s > 0.0 ? dot(n_plane, to_s) / d_s : 0.0;
         float above = ff.clipped_area / area_light_area(slot);
         if (!(ff.F > 0.0) || !(cos_s > 0.0) || !(above > 1e-6)) continue;
         w_i = normalize(ff.vector_);
@@ -181,6 +191,17 @@ void main() {
       }
       float cos_i = dot(n_i, w_i);
       if (cos_i <= 0.0) continue;  // interpolated normal turned away at a silhouette
+      // The disc's area maps onto the triangle's own area (the light map's projection), so E
+      // above is the irradiance across the triangle's plane, E cos_g; the light entering the
+      // surface is E cos_i with the shading normal, as the reference (and pbrt, Mitsuba) have
+      // it. On a faceted mesh the two differ point by point: on dragon:4, without this factor,
+      // the maps were 2.3% darker than the reference in every material (and exact on the same
+      // mesh flat-shaded). cos_g is floored as the area lights' cos_s below, for the texels a
+      // light sees at grazing incidence.
+#ifdef LUCENT_AREA_LIGHTS
+      if (!is_area)
+#endif
+      E *= cos_i / max(dot(n_plane, w_i), 0.15);
       sum += sample_.z * fresnel_transmittance(cos_i, u_eta) * fur_coat(cos_i) * E * bssrdf(x_i, n_i, w_i, x_o, n_o);
     }
   }

@@ -162,6 +162,7 @@ void RadianceMapRenderer::Impl::build_programs() {
   };
   unit(radiance_program, "u_light_positions", kUnitLightPositions);
   unit(radiance_program, "u_light_normals", kUnitLightNormals);
+  unit(radiance_program, "u_light_face_normals", kUnitLightFaceNormals);
   unit(radiance_program, "u_previous", kUnitPrevious);
   unit(blur_program, "u_source", 0);
   unit(final_program, "u_radiance", kUnitRadiance);
@@ -196,16 +197,19 @@ void RadianceMapRenderer::Impl::build_light_maps() {
   const int W = settings.light_map_size;
   light_positions = gl::create_texture(GL_TEXTURE_2D_ARRAY);
   light_normals = gl::create_texture(GL_TEXTURE_2D_ARRAY);
+  light_face_normals = gl::create_texture(GL_TEXTURE_2D_ARRAY);
   light_depth = gl::create_texture(GL_TEXTURE_2D_ARRAY);
   glTextureStorage3D(light_positions.id(), 1, GL_RGBA32F, W, W, L);
   glTextureStorage3D(light_normals.id(), 1, GL_RGBA32F, W, W, L);
+  glTextureStorage3D(light_face_normals.id(), 1, GL_RGBA16F, W, W, L);
   glTextureStorage3D(light_depth.id(), 1, GL_DEPTH_COMPONENT32F, W, W, L);
   light_fbo = gl::create_framebuffer();
   glNamedFramebufferTexture(light_fbo.id(), GL_COLOR_ATTACHMENT0, light_positions.id(), 0);
   glNamedFramebufferTexture(light_fbo.id(), GL_COLOR_ATTACHMENT1, light_normals.id(), 0);
+  glNamedFramebufferTexture(light_fbo.id(), GL_COLOR_ATTACHMENT2, light_face_normals.id(), 0);
   glNamedFramebufferTexture(light_fbo.id(), GL_DEPTH_ATTACHMENT, light_depth.id(), 0);
-  const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-  glNamedFramebufferDrawBuffers(light_fbo.id(), 2, buffers);
+  const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+  glNamedFramebufferDrawBuffers(light_fbo.id(), 3, buffers);
   gl::check_framebuffer(light_fbo.id(), "the light map");
   light_matrices = gl::create_buffer();
   glNamedBufferStorage(light_matrices.id(), kMaxLights * sizeof(detail::Mat4f), nullptr,
@@ -408,6 +412,7 @@ void RadianceMapRenderer::Impl::render_light_map() {
   const float one = 1.0f;
   glClearNamedFramebufferfv(light_fbo.id(), GL_COLOR, 0, zero);
   glClearNamedFramebufferfv(light_fbo.id(), GL_COLOR, 1, zero);
+  glClearNamedFramebufferfv(light_fbo.id(), GL_COLOR, 2, zero);
   glClearNamedFramebufferfv(light_fbo.id(), GL_DEPTH, 0, &one);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
@@ -465,6 +470,8 @@ void RadianceMapRenderer::Impl::render_radiance() {
   glBindSampler(kUnitLightPositions, nearest.id());
   glBindTextureUnit(kUnitLightNormals, light_normals.id());
   glBindSampler(kUnitLightNormals, nearest.id());
+  glBindTextureUnit(kUnitLightFaceNormals, light_face_normals.id());
+  glBindSampler(kUnitLightFaceNormals, nearest.id());
   glBindTextureUnit(kUnitPrevious, radiance[previous].id());
   glBindSampler(kUnitPrevious, nearest.id());
   if (settings.model == DiffusionModel::kTabulated) {

@@ -27,7 +27,7 @@ namespace maps_detail {
 constexpr int kMaxLights = 16;
 // Texture units.
 constexpr GLuint kUnitLightPositions = 0, kUnitLightNormals = 1, kUnitPrevious = 2,
-                 kUnitTabulated = 3;
+                 kUnitTabulated = 3, kUnitLightFaceNormals = 4;
 constexpr GLuint kUnitRadiance = 0, kUnitRadianceDepth = 1, kUnitEnvironment = 2,
                  kUnitLightPositionsFinal = 3;
 // Uniform-block bindings (as in the shaders).
@@ -74,7 +74,7 @@ struct RadianceMapRenderer::Impl {
       present_program;
 
   gl::Buffer light_matrices, layer_cameras, disc_buffer;
-  gl::Texture light_positions, light_normals, light_depth;
+  gl::Texture light_positions, light_normals, light_face_normals, light_depth;
   gl::Framebuffer light_fbo;
 
   std::array<gl::Texture, 2> radiance;
