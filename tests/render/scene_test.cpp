@@ -167,6 +167,25 @@ TEST(MeshFiles, EdgeSharedByThreeTrianglesIsNonManifold) {
   EXPECT_NE(err.find("7 non-manifold edges"), std::string::npos) << err;
 }
 
+// A closed tetrahedron whose one face is given three more times: once again, once starting at
+// another corner, once in the opposite winding (two parts of a scan that touch, as on dragon:4).
+// The surface is there once: the copies go, with one warning line, and the mesh is manifold.
+TEST(MeshFiles, TrianglesGivenTwiceAreDroppedWithOneWarningLine) {
+  const fs::path path = scratch("twins.obj");
+  write_text(path,
+             "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+             "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n"
+             "f 1 3 2\nf 3 2 1\nf 1 2 3\n");
+  testing::internal::CaptureStderr();
+  const Mesh mesh = load_mesh(path.string(), 10);
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(mesh.triangles.size(), 4u);
+  EXPECT_NE(err.find("dropped 3 triangles given twice"), std::string::npos) << err;
+  EXPECT_EQ(err.find("non-manifold"), std::string::npos) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  expect_unit_outward_normals(mesh);
+}
+
 TEST(MeshErrors, UnknownNameListsTheBuiltIns) {
   try {
     (void)load_mesh("teapot", 100);
