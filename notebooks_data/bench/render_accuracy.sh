@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The radiance maps against a converged CPU reference (issue "Previews you can trust"): meshes x
 # materials x models x settings, 64 px, a directional and a point light, subsurface only
-# (--specular off). Writes render_accuracy.csv beside this script. Usage:
-#   notebooks_data/bench/render_accuracy.sh [LUCENT_BINARY] [WORK_DIR]
+# (--specular off). Writes render_$MODE.csv beside this script. Usage:
+#   [MODE=accuracy|convergence|defaults] [MESHES="sphere dragon:4"] \
+#     notebooks_data/bench/render_accuracy.sh [LUCENT_BINARY] [WORK_DIR]
 # Costs on a 2-core llvmpipe machine: ~1 min per case at the light settings, ~5 min at the
 # default ones (8 s per frame), ~15 s per reference.
 set -euo pipefail
@@ -64,6 +65,13 @@ if [[ "$mode" == accuracy ]]; then
       done
     done
     run_case light "$mesh" ketchup ddipole 64 1,2,4,8,16,32,64 "${light[@]}"
+  done
+elif [[ "$mode" == defaults ]]; then
+  # The rest of dragon:4's default-settings matrix (the convergence run has the ddipole rows).
+  for material in marble potato skin1; do
+    for model in dipole tabulated; do
+      run_case default dragon:4 "$material" "$model" 32 1,2,4,8,16,32
+    done
   done
 else
   run_case light sphere marble ddipole 64 1,2,4,8,16,32,64 "${light[@]}"

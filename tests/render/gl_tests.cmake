@@ -7,6 +7,9 @@ lucent_add_test(glsl_twin_test
 lucent_add_test(radiance_maps_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/radiance_maps_test.cpp
   LIBS lucent::render lucent::materials OpenGL::OpenGL)
+lucent_add_test(faceted_mesh_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/faceted_mesh_test.cpp
+  LIBS lucent::render lucent::materials OpenGL::OpenGL)
 lucent_add_test(slab_truth_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/slab_truth_test.cpp
   LIBS lucent::render lucent::materials OpenGL::OpenGL)
