@@ -2,7 +2,8 @@
 # The radiance maps against a converged CPU reference (issue "Previews you can trust"): meshes x
 # materials x models x settings, 64 px, a directional and a point light, subsurface only
 # (--specular off). Writes render_$MODE.csv beside this script. Usage:
-#   [MODE=accuracy|convergence|defaults] [MESHES="sphere dragon:4"] \
+#   [MODE=accuracy|convergence|defaults] [MESHES="sphere dragon:4"] [CSV=FILE] \
+#     [DRAGON_MATERIALS="marble potato skin1"] [EXTRA="sphere:potato:tabulated ..."] \
 #     notebooks_data/bench/render_accuracy.sh [LUCENT_BINARY] [WORK_DIR]
 # Costs on a 2-core llvmpipe machine: ~1 min per case at the light settings, ~5 min at the
 # default ones (8 s per frame), ~15 s per reference.
@@ -12,7 +13,7 @@ lucent="${1:-$here/../../build/ci/cli/lucent}"
 work="${2:-$(mktemp -d)}"
 mkdir -p "$work"
 mode="${MODE:-accuracy}"
-csv="$here/render_$mode.csv"
+csv="${CSV:-$here/render_$mode.csv}"
 lights=(--light directional:1,0.5,0.5:1,1,1 --light point:-60,60,80:5000,5000,5000)
 common=(--size 64x64 --threads 2 --specular off "${lights[@]}")
 reference_probes=8192
@@ -68,10 +69,15 @@ if [[ "$mode" == accuracy ]]; then
   done
 elif [[ "$mode" == defaults ]]; then
   # The rest of dragon:4's default-settings matrix (the convergence run has the ddipole rows).
-  for material in marble potato skin1; do
+  for material in ${DRAGON_MATERIALS-marble potato skin1}; do
     for model in dipole tabulated; do
       run_case default dragon:4 "$material" "$model" 32 1,2,4,8,16,32
     done
+  done
+  # More cases on request: EXTRA="mesh:material:model ..." (e.g. sphere:potato:tabulated).
+  for extra in ${EXTRA:-}; do
+    IFS=: read -r mesh material model <<< "$extra"
+    run_case default "$mesh" "$material" "$model" 32 1,2,4,8,16,32
   done
 else
   run_case light sphere marble ddipole 64 1,2,4,8,16,32,64 "${light[@]}"
