@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""render_accuracy.csv, render_convergence.csv and render_defaults.csv (from render_accuracy.sh) -> render_accuracy.md:
+"""render_accuracy.csv, render_convergence.csv and render_defaults.csv (from render_accuracy.sh)
+-> render_accuracy.md:
 per setting, mesh, material and model, the radiance maps' error against the converged CPU
 reference after the last frame, and the first snapshot frame within 2% (relative RMSE) of the
 last frame's image."""
@@ -24,7 +25,7 @@ out = ["# The radiance maps against a converged CPU reference", "",
        "the whole render on llvmpipe.", ""]
 for name, title in (("accuracy", "Every model and material (accuracy)"),
                     ("convergence", "Frames to converge (no mip blur: the profile disc's default)"),
-                    ("defaults", "The rest of dragon:4 at the default settings")):
+                    ("defaults", "The rest of the default settings (dragon:4 by model and material, more sphere cases)")):
     path = os.path.join(here, f"render_{name}.csv")
     if not os.path.exists(path):
         continue

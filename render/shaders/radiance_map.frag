@@ -148,7 +148,7 @@ void main() {
       // profile's curvature). The triangle's plane, not the shading normal's: on a faceted mesh
       // the interpolated normal tilts that plane off the surface by degrees, so near samples
       // landed a texel x tan(tilt) above or below it; on dragon:4 that took 6-26% off a material
-      // whose mean free path is 0.01-0.05 mm (dense.json in the truth tests) and 2% off marble.
+      // whose mean free path is 0.01-0.05 mm (the dense medium of faceted_mesh_test).
       // Kept to a few texels along the ray, so grazing texels fall back to their centre.
       vec3 n_plane = texelFetch(u_light_face_normals, at, 0).xyz;
       vec3 origin = is_point ? light.xyz : x_d;
@@ -196,8 +196,9 @@ void main() {
       // surface is E cos_i with the shading normal, as the reference (and pbrt, Mitsuba) have
       // it. On a faceted mesh the two differ point by point: on dragon:4, without this factor,
       // the maps were 2.3% darker than the reference in every material (and exact on the same
-      // mesh flat-shaded). cos_g is floored as the area lights' cos_s below, for the texels a
-      // light sees at grazing incidence.
+      // mesh flat-shaded). cos_g is floored at 0.15, as the area lights' cos_s above, for the
+      // texels a light sees at grazing incidence. (An area light's E is already the shading
+      // normal's: its mapping is undone with cos_g above.)
 #ifdef LUCENT_AREA_LIGHTS
       if (!is_area)
 #endif
