@@ -1,8 +1,10 @@
 // Finding or building the oblique slice of a fit (oblique_table.h).
 #include "oblique_table.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <sstream>
 
@@ -13,6 +15,50 @@
 #include "progress.h"
 
 namespace lucent::cli {
+
+namespace {
+
+// The table `name` from the cache when it holds what `has` asks, else built from `o` now (progress
+// on stderr unless quiet) and kept in the cache at once: a fit that fails later must not cost the
+// next one this build. A cache that cannot be read or written is only a warning.
+materials::TransportTable cached_or_built(
+    const std::string& name, const acquire::TabulateOptions& o,
+    const std::function<bool(const materials::TransportTable&)>& has, const std::string& what,
+    const std::string& kind, bool quiet) {
+  const std::filesystem::path dir = materials::oblique_cache_dir();
+  const std::filesystem::path cached = dir.empty() ? std::filesystem::path() : dir / name;
+  if (!cached.empty() && std::filesystem::exists(cached)) {
+    try {
+      materials::TransportTable t = materials::read_transport_table(cached);
+      if (has(t)) return t;
+    } catch (const Error& e) {
+      warn("lucent fit: warning: the cached " + kind + " table is unreadable, rebuilding it (" +
+           std::string(e.what()) + ")");
+    }
+  }
+  if (!quiet)
+    std::cerr << "lucent fit: building the " << what << "; kept in "
+              << (cached.empty() ? std::string("no cache") : cached.string()) << ")\n";
+  ProgressLine line("lucent fit: " + kind + " table", "white-run photons", quiet);
+  const auto progress = [&](std::uint64_t done, std::uint64_t total) { line.update(done, total); };
+  materials::TransportTable t = acquire::tabulate_transport(o, progress);
+  line.finish();
+  if (!cached.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    try {
+      if (ec) throw Error(dir.string() + ": " + ec.message());
+      materials::write_transport_table(t, cached);
+      commit_pending_outputs();
+    } catch (const Error& e) {
+      warn("lucent fit: warning: the " + kind + " table is not kept (" + e.what() + ")");
+    }
+  }
+  t.source = cached.empty() ? std::string("(built for this fit)") : cached.string();
+  return t;
+}
+
+}  // namespace
 
 std::optional<materials::TransportTable> oblique_table_for(
     const std::vector<fit::ProfileData>& data, const fit::FitOptions& options,
@@ -47,47 +93,74 @@ std::optional<materials::TransportTable> oblique_table_for(
   std::ostringstream name;
   // "2": the table format whose radiance leaves the single-scattering line out.
   name << "oblique2-eta" << *eta << "-g" << g << "-inc" << *incidence << "-n" << photons << ".lut";
-  const std::filesystem::path dir = materials::oblique_cache_dir();
-  const std::filesystem::path cached = dir.empty() ? std::filesystem::path() : dir / name.str();
-  if (!cached.empty() && std::filesystem::exists(cached)) {
-    try {
-      materials::TransportTable t = materials::read_transport_table(cached);
-      if (has(t)) return t;
-    } catch (const Error& e) {
-      warn("lucent fit: warning: the cached oblique table is unreadable, rebuilding it (" +
-           std::string(e.what()) + ")");
-    }
-  }
   acquire::TabulateOptions o;
   o.eta = {*eta};
   o.g = {g};
   o.incidence_deg = {*incidence};
   o.grid = materials::default_oblique_grid();
   o.photons = photons;
-  if (!quiet)
-    std::cerr << "lucent fit: building the oblique transport table for eta " << *eta << ", g "
-              << g << ", incidence " << *incidence << " degrees (" << photons
-              << " photons; kept in " << (cached.empty() ? std::string("no cache") : cached.string())
-              << ")\n";
-  ProgressLine line("lucent fit: oblique table", "white-run photons", quiet);
-  const auto progress = [&](std::uint64_t done, std::uint64_t total) { line.update(done, total); };
-  materials::TransportTable t = acquire::tabulate_transport(o, progress);
-  line.finish();
-  if (!cached.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    // Kept at once (the fit's own outputs are still to come): a fit that fails later must not
-    // cost the next one this build. A cache that cannot be written is only a warning.
-    try {
-      if (ec) throw Error(dir.string() + ": " + ec.message());
-      materials::write_transport_table(t, cached);
-      commit_pending_outputs();
-    } catch (const Error& e) {
-      warn(std::string("lucent fit: warning: the oblique table is not kept (") + e.what() + ")");
-    }
+  std::ostringstream what;
+  what << "oblique transport table for eta " << *eta << ", g " << g << ", incidence " << *incidence
+       << " degrees (" << photons << " photons";
+  return cached_or_built(name.str(), o, has, what.str(), "oblique", quiet);
+}
+
+materials::TransportTableGrid radial_fit_grid() {
+  materials::TransportTableGrid grid = materials::default_transport_grid();
+  for (double u : {0.999, 0.9995, 0.9999}) grid.u.push_back(u);
+  return grid;
+}
+
+std::optional<materials::TransportTable> radial_table_for(const std::vector<fit::ProfileData>& data,
+                                                          const fit::FitOptions& options,
+                                                          std::uint64_t photons, bool quiet) {
+  if (options.fit_ior || options.model == fit::FitModel::kDipole ||
+      options.model == fit::FitModel::kDirectionalDipole)
+    return std::nullopt;
+  for (const fit::ProfileData& d : data) {
+    // Only radial profiles at normal incidence and view (what the tabulated model is for).
+    if (d.samples_2d.has_value() || d.incidence_polar_deg > 0.5 ||
+        (!d.exitance && d.view_deg > 0.5))
+      return std::nullopt;
   }
-  t.source = cached.empty() ? std::string("(built for this fit)") : cached.string();
-  return t;
+  const std::optional<double> eta = options.ior ? options.ior : data.front().eta;
+  if (!eta || *eta < 1.0 || *eta > 2.5) return std::nullopt;  // the fit says why
+  const double g = options.g;
+  // A slice at exactly this g, over an eta range that holds the data's (interpolating in eta is
+  // harmless; in g it is not near black: coffee's green channel, g 0.896, was 8-9% off with the
+  // shipped table's nodes 0.8 and 0.9 around it, and red, g 0.907, 0.2-0.8% off with its own).
+  const auto has = [&](const materials::TransportTable& t) {
+    if (t.partial || t.grid.phi_bins != 1) return false;
+    double eta_min = INFINITY, eta_max = -INFINITY;
+    for (const materials::TransportTableSlice& s : t.slices) {
+      if (std::abs(s.g - g) > 1e-9) continue;
+      eta_min = std::min(eta_min, s.eta), eta_max = std::max(eta_max, s.eta);
+    }
+    return *eta >= eta_min - 1e-9 && *eta <= eta_max + 1e-9;
+  };
+  // A table given with --table is the user's choice (its refusal of a g it lacks stands), and a
+  // shipped table that cannot be read is the fit's to report.
+  if (options.table) return std::nullopt;
+  try {
+    if (has(materials::default_transport_table())) return std::nullopt;
+  } catch (const Error&) {
+    return std::nullopt;
+  }
+  acquire::TabulateOptions o;
+  o.eta = {*eta};
+  o.g = {g};
+  o.grid = radial_fit_grid();
+  o.photons = photons;
+  // The white run (alpha' >= 0.4) costs 1 / (1 - g) collisions per transport length: scaled so
+  // that it costs what 150,000 photons cost at g = 0.9 per million (about a minute here); the
+  // near-black nodes, which the media of such g need most, are direct runs of the full count.
+  o.white_photons = std::clamp(std::uint64_t(double(photons) * 1.5 * (1 - g)),
+                               std::uint64_t(o.groups) * 64, photons);
+  std::ostringstream name, what;
+  name << "radial1-eta" << *eta << "-g" << g << "-n" << photons << ".lut";
+  what << "radial transport table for eta " << *eta << ", g " << g << " (" << photons
+       << " photons per albedo node, " << o.white_photons << " in the white run";
+  return cached_or_built(name.str(), o, has, what.str(), "radial", quiet);
 }
 
 }  // namespace lucent::cli

@@ -1,4 +1,6 @@
-// The oblique transport table a fit of 2D oblique captures needs (no CLI11 here).
+// The transport tables a fit needs beyond the shipped ones, found in the cache or built now: the
+// oblique slice of 2D oblique captures, the radial slice of a g outside the radial table (no
+// CLI11 here).
 #pragma once
 
 #include <cstdint>
@@ -12,11 +14,27 @@
 namespace lucent::cli {
 
 /// The table holding the slice (eta, g, incidence) of these data, or nothing when they need none
-/// (radial data, a dipole model, --fit-ior, `given` "none"). In order: `given` (--oblique-table; an error when it
-/// lacks the slice), the shipped table, the cache (materials::oblique_cache_dir()), else the slice
-/// is built now with `photons` photons (progress on stderr unless quiet) and kept in the cache.
+/// (radial data, a dipole model, --fit-ior, `given` "none"). In order: `given` (--oblique-table; an
+/// error when it lacks the slice), the shipped table, the cache (materials::oblique_cache_dir()),
+/// else the slice is built now with `photons` photons (progress on stderr unless quiet) and kept in
+/// the cache.
 std::optional<materials::TransportTable> oblique_table_for(
     const std::vector<fit::ProfileData>& data, const fit::FitOptions& options,
     const std::string& given, std::uint64_t photons, bool quiet);
+
+/// The radial table of these data when the shipped table has no slice at their g (a g between its
+/// nodes or beyond them), or nothing when it has one or they need none (a table given with --table,
+/// 2D or oblique data, a dipole model, --fit-ior, no index). The slice at exactly (eta, g) comes
+/// from the cache, else is built now with `photons` photons per albedo node (the white run's scaled
+/// by 1.5 (1 - g): a minute per million here whatever g) on the default grid with near-black nodes
+/// down to alpha' 2e-4, and kept in the cache.
+std::optional<materials::TransportTable> radial_table_for(const std::vector<fit::ProfileData>& data,
+                                                          const fit::FitOptions& options,
+                                                          std::uint64_t photons, bool quiet);
+
+/// The grid of a radial slice built for a fit: the shipped table's, with albedo nodes down to
+/// alpha' = 2e-4 (near-black media of high g, where the shipped table's last node, alpha' = 0.004,
+/// still scatters a sixth of the light at g = 0.98).
+materials::TransportTableGrid radial_fit_grid();
 
 }  // namespace lucent::cli
