@@ -36,6 +36,12 @@ std::string model_name(FitModel m) {
   return to_string(m);
 }
 
+std::string g_text(double g) {  // 0.917, not std::to_string's 0.917000 cut to 0.91
+  std::ostringstream s;
+  s << g;
+  return s.str();
+}
+
 }  // namespace
 
 FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& options) {
@@ -325,13 +331,13 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
       result.reason =
           "tabulated: oblique incidence, the directional dipole corrected by lucent's Monte Carlo "
           "transport table (g = " +
-          std::to_string(options.g).substr(0, 4) +
+          g_text(options.g) +
           ") to transport at normal incidence; the cheaper models are judged against it";
     } else if (options.model == FitModel::kAuto) {
       result.reason =
           "tabulated: exact to radiative transfer for a radial profile at normal incidence "
           "(lucent's Monte Carlo transport table at g = " +
-          std::to_string(options.g).substr(0, 4) + "); the cheaper models are judged against it";
+          g_text(options.g) + "); the cheaper models are judged against it";
     } else {
       result.reason = "model " + model_name(result.chosen.model) + " requested";
     }
