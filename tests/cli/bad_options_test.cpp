@@ -92,7 +92,7 @@ std::vector<BadCase> option_cases() {
       {"fit_batch_not_a_manifest", nullptr,
        "fit --batch {world}/acq/profile.json -o {dir}/s.json", "column"},
       {"fit_ior_five", nullptr, fit + "--ior 5", "--ior"},
-      {"fit_g_099", nullptr, fit + "--g 0.99", "--g"},
+      {"fit_g_0995", nullptr, fit + "--g 0.995", "--g"},
       {"fit_loss_trailing_garbage", nullptr, fit + "--loss huber:1abc", "--loss"},
       {"fit_loss_foo", nullptr, fit + "--loss foo", "--loss"},
       {"fit_quality_foo", nullptr, fit + "--quality foo", "--quality"},

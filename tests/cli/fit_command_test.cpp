@@ -154,7 +154,9 @@ INSTANTIATE_TEST_SUITE_P(
                "/materials/tables/transport.lut -o {OUT}",
                "--g"},
         BadFit{"bad_model", good_csv(), "fit {IN} --ior 1.5 --model tripole -o {OUT}", "--model"},
-        BadFit{"ior_outside_table", good_csv(), "fit {IN} --ior 2.2 --model tabulated -o {OUT}",
+        BadFit{"ior_outside_table", good_csv(),
+               "fit {IN} --ior 2.2 --model tabulated --table " LUCENT_SOURCE_DIR
+               "/materials/tables/transport.lut -o {OUT}",
                "outside the transport table"},
         BadFit{"empty_profile", "r_mm,R,se\n", "fit {IN} --ior 1.5 -o {OUT}", "empty"},
         BadFit{"too_few_samples", "r_mm,R,se\n1,0.03,0.001\n",
