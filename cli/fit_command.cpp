@@ -120,9 +120,9 @@ materials::Material run(const FitArguments& a) {
     table = materials::read_transport_table(a.table);
     options.table = &table;
   }
-  const std::optional<materials::TransportTable> radial =
-      radial_table_for(data, options, a.table_photons, a.json || a.quiet || a.no_progress);
-  if (radial) options.table = &*radial;
+  if (const materials::TransportTable* radial =
+          radial_table_for(data, options, a.table_photons, a.json || a.quiet || a.no_progress))
+    options.table = radial;
   const std::optional<materials::TransportTable> oblique =
       oblique_table_for(data, options, a.oblique_table, a.oblique_photons, a.json);
   if (oblique) options.oblique_table = &*oblique;

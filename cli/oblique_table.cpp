@@ -6,12 +6,14 @@
 #include <filesystem>
 #include <functional>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 #include "lucent/acquire/tabulate.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
 #include "lucent/materials/oblique.h"
+#include "lucent/materials/radial_slices.h"
 #include "progress.h"
 
 namespace lucent::cli {
@@ -111,20 +113,20 @@ materials::TransportTableGrid radial_fit_grid() {
   return grid;
 }
 
-std::optional<materials::TransportTable> radial_table_for(const std::vector<fit::ProfileData>& data,
-                                                          const fit::FitOptions& options,
-                                                          std::uint64_t photons, bool quiet) {
+const materials::TransportTable* radial_table_for(const std::vector<fit::ProfileData>& data,
+                                                  const fit::FitOptions& options,
+                                                  std::uint64_t photons, bool quiet) {
   if (options.fit_ior || options.model == fit::FitModel::kDipole ||
       options.model == fit::FitModel::kDirectionalDipole)
-    return std::nullopt;
+    return nullptr;
   for (const fit::ProfileData& d : data) {
     // Only radial profiles at normal incidence and view (what the tabulated model is for).
     if (d.samples_2d.has_value() || d.incidence_polar_deg > 0.5 ||
         (!d.exitance && d.view_deg > 0.5))
-      return std::nullopt;
+      return nullptr;
   }
   const std::optional<double> eta = options.ior ? options.ior : data.front().eta;
-  if (!eta || *eta < 1.0 || *eta > 2.5) return std::nullopt;  // the fit says why
+  if (!eta || *eta < 1.0 || *eta > 2.5) return nullptr;  // the fit says why
   const double g = options.g;
   // A slice at exactly this g, over an eta range that holds the data's (interpolating in eta is
   // harmless; in g it is not near black: coffee's green channel, g 0.896, was 8-9% off with the
@@ -140,11 +142,11 @@ std::optional<materials::TransportTable> radial_table_for(const std::vector<fit:
   };
   // A table given with --table is the user's choice (its refusal of a g it lacks stands), and a
   // shipped table that cannot be read is the fit's to report.
-  if (options.table) return std::nullopt;
+  if (options.table) return nullptr;
   try {
-    if (has(materials::default_transport_table())) return std::nullopt;
+    if (has(materials::default_transport_table())) return nullptr;
   } catch (const Error&) {
-    return std::nullopt;
+    return nullptr;
   }
   acquire::TabulateOptions o;
   o.eta = {*eta};
@@ -156,11 +158,18 @@ std::optional<materials::TransportTable> radial_table_for(const std::vector<fit:
   // near-black nodes, which the media of such g need most, are direct runs of the full count.
   o.white_photons = std::clamp(std::uint64_t(double(photons) * 1.5 * (1 - g)),
                                std::uint64_t(o.groups) * 64, photons);
-  std::ostringstream name, what;
-  name << "radial1-eta" << *eta << "-g" << g << "-n" << photons << ".lut";
+  // Kept for the process (a batch's rows of one (eta, g) share it; the prepared profiles are keyed
+  // by the table's address, which must not be reused by another table).
+  static std::map<std::string, const materials::TransportTable*> kept;
+  const std::string name = materials::radial_slice_file_name(*eta, g, photons);
+  if (const auto it = kept.find(name); it != kept.end()) return it->second;
+  std::ostringstream what;
   what << "radial transport table for eta " << *eta << ", g " << g << " (" << photons
        << " photons per albedo node, " << o.white_photons << " in the white run";
-  return cached_or_built(name.str(), o, has, what.str(), "radial", quiet);
+  const materials::TransportTable* t =
+      &materials::keep_transport_table(cached_or_built(name, o, has, what.str(), "radial", quiet));
+  kept[name] = t;
+  return t;
 }
 
 }  // namespace lucent::cli

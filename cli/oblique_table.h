@@ -23,14 +23,15 @@ std::optional<materials::TransportTable> oblique_table_for(
     const std::string& given, std::uint64_t photons, bool quiet);
 
 /// The radial table of these data when the shipped table has no slice at their g (a g between its
-/// nodes or beyond them), or nothing when it has one or they need none (a table given with --table,
+/// nodes or beyond them), or null when it has one or they need none (a table given with --table,
 /// 2D or oblique data, a dipole model, --fit-ior, no index). The slice at exactly (eta, g) comes
 /// from the cache, else is built now with `photons` photons per albedo node (the white run's scaled
 /// by 1.5 (1 - g): a minute per million here whatever g) on the default grid with near-black nodes
-/// down to alpha' 2e-4, and kept in the cache.
-std::optional<materials::TransportTable> radial_table_for(const std::vector<fit::ProfileData>& data,
-                                                          const fit::FitOptions& options,
-                                                          std::uint64_t photons, bool quiet);
+/// down to alpha' 2e-4, and kept in the cache (materials::radial_slice_file_name) and for the
+/// process.
+const materials::TransportTable* radial_table_for(const std::vector<fit::ProfileData>& data,
+                                                  const fit::FitOptions& options,
+                                                  std::uint64_t photons, bool quiet);
 
 /// The grid of a radial slice built for a fit: the shipped table's, with albedo nodes down to
 /// alpha' = 2e-4 (near-black media of high g, where the shipped table's last node, alpha' = 0.004,

@@ -439,10 +439,20 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
     // g: radial data cannot tell it from sigma_s; say how far the answer moves at the other end.
     const double g_other = options.g < 0.45 ? 0.9 : 0.0;
     try {
-      const materials::TransportTable& file =
-          options.table ? *options.table : materials::default_transport_table();
-      const auto other_profile = materials::cached_tabulated_profile(
-          file, g_other, options.fit_ior ? std::nullopt : std::optional<double>(result.chosen.eta));
+      // The table in use, or the shipped one when it has no slice at g_other (a slice built for
+      // this fit's g holds that g alone).
+      const std::optional<double> eta_held =
+          options.fit_ior ? std::nullopt : std::optional<double>(result.chosen.eta);
+      std::shared_ptr<const materials::TabulatedProfile> other_profile;
+      try {
+        other_profile = materials::cached_tabulated_profile(
+            options.table ? *options.table : materials::default_transport_table(), g_other,
+            eta_held);
+      } catch (const Error&) {
+        if (!options.table) throw;
+        other_profile = materials::cached_tabulated_profile(materials::default_transport_table(),
+                                                            g_other, eta_held);
+      }
       const materials::TabulatedProfile& other = *other_profile;
       const std::array<StartValues, 3> st = started_from(result.chosen);
       int ignored = 0;

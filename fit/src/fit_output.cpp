@@ -86,9 +86,10 @@ json g_systematic_json(const FitResult& r) {
           {"other_g", r.g_other},
           {"shift_sigma_a", shift_a},
           {"shift_sigma_s_reduced", shift_s},
-          {"note", "radial normal-incidence data cannot separate g from sigma_s: the fit at "
-                   "other_g moves by these amounts (mm^-1); not in the total, which holds for "
-                   "the assumed g"}};
+          {"note",
+           "radial normal-incidence data cannot separate g from sigma_s: the fit at "
+           "other_g moves by these amounts (mm^-1); not in the total, which holds for "
+           "the assumed g"}};
 }
 
 json inputs_json(const std::vector<ProfileData>& data) {
@@ -107,6 +108,14 @@ materials::Material fitted_material(const FitResult& result, const std::vector<P
   m.ior = f.eta;
   m.model = name_of(f.model);
   m.adequate_model = result.adequate_model;
+  // A tabulated fit at an assumed g > 0 measured that medium: the file says so (sigma_s and g
+  // beside sigma_s'), so that lucent profile and the renderers evaluate the model at the same g.
+  const bool anisotropic = f.model == FitModel::kTabulated && result.g > 0;
+  if (anisotropic) {
+    m.g = materials::Rgb{result.g, result.g, result.g};
+    m.sigma_s = materials::Rgb{};
+    for (int c = 0; c < 3; ++c) (*m.sigma_s)[c] = f.channels[c].sigma_s_reduced / (1 - result.g);
+  }
   json sd_a = json::array(), sd_s = json::array(), corr = json::array();
   json stat_a = json::array(), stat_s = json::array(), sys_a = json::array(), sys_s = json::array();
   for (int c = 0; c < 3; ++c) {
@@ -129,7 +138,8 @@ materials::Material fitted_material(const FitResult& result, const std::vector<P
       {"correlation_sigma_a_sigma_s_reduced", corr},
       {"kind",
        "one standard deviation, mm^-1: total = statistical (Jacobian at the solution, "
-       "calibration prior included, scaled by the root of the reduced chi^2 or, for pixels, the design effect, when above 1) and "
+       "calibration prior included, scaled by the root of the reduced chi^2 or, for pixels, the "
+       "design effect, when above 1) and "
        "systematic "
        "(the model's own error: a diffusion model's difference from the tabulated model on the "
        "same data) in quadrature"}};

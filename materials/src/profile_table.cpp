@@ -9,6 +9,7 @@
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/error.h"
 #include "lucent/materials/quadrature.h"
+#include "lucent/materials/radial_slices.h"
 #include "lucent/materials/tabulated.h"
 
 namespace lucent::materials {
@@ -71,8 +72,9 @@ DiffusionModel parse_diffusion_model(const std::string& name, const std::string&
   if (name == "ddipole") return DiffusionModel::kDirectionalDipole;
   if (name == "tabulated" && allow_tabulated) return DiffusionModel::kTabulated;
   if (name == "tabulated")
-    throw Error(option + ": 'tabulated' is radial only (normal incidence on a plane); expected "
-                         "'dipole' or 'ddipole' here");
+    throw Error(option +
+                ": 'tabulated' is radial only (normal incidence on a plane); expected "
+                "'dipole' or 'ddipole' here");
   throw Error(option + ": expected 'dipole', 'ddipole'" +
               std::string(allow_tabulated ? " or 'tabulated'" : "") + ", got '" + name + "'");
 }
@@ -83,20 +85,19 @@ std::string to_string(DiffusionModel model) {
                                                        : "tabulated";
 }
 
-// One prepared profile per g (materials with sigma_s and g carry their own per channel).
-const TabulatedProfile& tabulated_profile_for(double g) {
-  return *cached_tabulated_profile(default_transport_table(), g);
-}
-
 DiffusionModel preferred_model(const Material& material) {
   const std::string fitted = material.diffusion_model("");
-  if (!fitted.empty()) return parse_diffusion_model(fitted, "model", true);
+  if (!fitted.empty() && fitted != "tabulated") return parse_diffusion_model(fitted, "model", true);
+  // A tabulated fit renders tabulated where a table serves its (g, eta) here (the shipped one, or
+  // the slice its fit built and cached), else with its cheapest adequate model.
   try {
     for (int c = 0; c < 3; ++c) {
       radial_profile_value(material, c, DiffusionModel::kTabulated, TableQuantity::kRadiance, 1.0);
     }
     return DiffusionModel::kTabulated;
   } catch (const Error&) {
+    if (fitted == "tabulated" && !material.adequate_model.empty())
+      return parse_diffusion_model(material.adequate_model, "adequate_model", false);
     return DiffusionModel::kDirectionalDipole;  // eta or g outside the table
   }
 }
@@ -151,8 +152,9 @@ std::vector<double> parse_radius_range(const std::string& text, const std::strin
 std::array<double, 3> evaluate_bssrdf(const Material& material, DiffusionModel model,
                                       const BssrdfConfig& c) {
   if (model == DiffusionModel::kTabulated)
-    throw Error("--configs: the tabulated model is radial only (normal incidence on a plane); "
-                "use --r or --r-range");
+    throw Error(
+        "--configs: the tabulated model is radial only (normal incidence on a plane); "
+        "use --r or --r-range");
   std::array<double, 3> S{};
   for (int channel = 0; channel < 3; ++channel) {
     const Medium<double> medium = material.medium(channel);
@@ -176,19 +178,17 @@ double radial_profile_value(const Material& material, int channel, DiffusionMode
     }
     case DiffusionModel::kDirectionalDipole: {
       const DirectionalDipole<double> ddipole(medium);
-      const double pi_s = std::numbers::pi * ddipole.S_d(Vec3<double>::Zero(), plane_normal(),
-                                                         plane_normal(), Vec3<double>(r, 0.0, 0.0),
-                                                         plane_normal());
-      return pi_s * (radiance ? fresnel_transmittance(1.0, medium.eta)
-                              : medium.eta * medium.eta *
-                                    (1 - diffuse_fresnel_reflectance(medium.eta)));
+      const double pi_s =
+          std::numbers::pi * ddipole.S_d(Vec3<double>::Zero(), plane_normal(), plane_normal(),
+                                         Vec3<double>(r, 0.0, 0.0), plane_normal());
+      return pi_s * (radiance
+                         ? fresnel_transmittance(1.0, medium.eta)
+                         : medium.eta * medium.eta * (1 - diffuse_fresnel_reflectance(medium.eta)));
     }
     case DiffusionModel::kTabulated: {
-      const TabulatedProfile& p = tabulated_profile_for(medium.g);
-      if (medium.eta < p.eta_min() - 1e-12 || medium.eta > p.eta_max() + 1e-12)
-        throw Error("ior: " + format_input(medium.eta) + " is outside the transport table's eta range " +
-                    format_input(p.eta_min()) + ".." + format_input(p.eta_max()));
-      return TabulatedModel<double>(p, medium).at(quantity, r);
+      // Materials with sigma_s and g carry their own g per channel.
+      return TabulatedModel<double>(*radial_profile_for(medium.g, medium.eta), medium)
+          .at(quantity, r);
     }
   }
   return 0.0;
@@ -198,15 +198,15 @@ std::string radial_profile_csv(const Material& material, const RadialProfileOpti
   std::ostringstream out;
   out << "# format=lucent-radial-profile version=1 quantity=" << to_string(options.quantity)
       << " ior=" << format_input(material.ior) << " model=" << to_string(options.model)
-      << " incidence_deg=0 units=mm^-2_per_unit_power_entering material=" << material.name
-      << "\n";
+      << " incidence_deg=0 units=mm^-2_per_unit_power_entering material=" << material.name << "\n";
   std::ostringstream rows;
   rows << "r_mm,R_r,R_g,R_b\n";
   for (double r : options.r_mm) {
     rows << format_input(r);
     for (int channel = 0; channel < 3; ++channel)
-      rows << ',' << format_number(radial_profile_value(material, channel, options.model,
-                                                        options.quantity, r));
+      rows << ','
+           << format_number(
+                  radial_profile_value(material, channel, options.model, options.quantity, r));
     rows << '\n';
   }
   if (options.total) {
@@ -218,7 +218,7 @@ std::string radial_profile_csv(const Material& material, const RadialProfileOpti
         total = StandardDipole<double>(medium).total_diffuse_reflectance();
       } else if (options.model == DiffusionModel::kTabulated) {
         radial_profile_value(material, channel, options.model, options.quantity, 1.0);  // range
-        total = TabulatedModel<double>(tabulated_profile_for(medium.g), medium)
+        total = TabulatedModel<double>(*radial_profile_for(medium.g, medium.eta), medium)
                     .total_diffuse_reflectance();
       } else {
         const auto c = derive_coefficients(medium);

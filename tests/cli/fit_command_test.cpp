@@ -86,10 +86,24 @@ TEST(FitCommand, BuildsTheSliceOfAGBeyondTheShippedTable) {
       EXPECT_LT(sd, 0.1 * truth) << key << " channel " << c;
     }
   }
+  // The material says what was measured (g and sigma_s beside sigma_s'), and lucent profile
+  // evaluates it with the slice the fit built; with another cache it names what is missing.
+  const nlohmann::json material = nlohmann::json::parse(read_text(dir / "fit.json"));
+  EXPECT_EQ(material["g"][0], 0.95);
+  EXPECT_NEAR(double(material["sigma_s"][1]) * 0.05, double(material["sigma_s_reduced"][1]), 1e-12);
+  const std::string profile =
+      "profile --material \"" + (dir / "fit.json").string() + "\" --model tabulated --r 1,3";
+  r = run_lucent(profile, "g-slice-profile");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\n1,"), std::string::npos) << r.out;
   r = run_lucent(fit, "g-slice-2");
-  ::unsetenv("LUCENT_CACHE_DIR");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err.find("building"), std::string::npos) << r.err;  // the cached slice
+  ::setenv("LUCENT_CACHE_DIR", (dir / "empty").c_str(), 1);
+  r = run_lucent(profile, "g-slice-profile-empty");
+  ::unsetenv("LUCENT_CACHE_DIR");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("g: 0.95 (the material's)"), std::string::npos) << r.err;
   fs::remove_all(dir);
 }
 

@@ -7,12 +7,15 @@
 #include <ceres/jet.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <cstdio>
 #include <random>
 
 #include "lucent/materials/error.h"
+#include "lucent/materials/material.h"
+#include "lucent/materials/profile_table.h"
+#include "lucent/materials/radial_slices.h"
 #include "lucent/materials/transport_table.h"
 
 namespace lucent::materials {
@@ -109,7 +112,8 @@ TransportTable synthetic_table() {
           double avg = 0;
           for (int m = 0; m < 200; ++m) {
             const double r = std::sqrt(r0 * r0 + (m + 0.5) / 200 * (r1 * r1 - r0 * r0));
-            avg += (1 - t.grid.u[k] * t.grid.u[k]) * std::exp(-2 * t.grid.u[k] * r + eta) / (r + 0.1) * (q + 1) / 200;
+            avg += (1 - t.grid.u[k] * t.grid.u[k]) * std::exp(-2 * t.grid.u[k] * r + eta) /
+                   (r + 0.1) * (q + 1) / 200;
           }
           s.value[std::size_t(q)].push_back(float(std::max(avg, 1e-37)));  // as the writer clamps
           s.se_code[std::size_t(q)].push_back(encode_relative_se(0.01, false));
@@ -166,7 +170,8 @@ TEST(TabulatedProfile, FiniteAtTheExtremes) {
 }
 
 TEST(TransportTableFile, RoundTripsAndRejectsDamage) {
-  const fs::path dir = fs::temp_directory_path() / ("lucent_table_test_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("lucent_table_test_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const TransportTable t = synthetic_table();
   write_transport_table(t, dir / "t.lut");
@@ -198,7 +203,8 @@ TEST(TransportTableFile, RoundTripsAndRejectsDamage) {
       },
       Error);
   EXPECT_THROW(read_transport_table(write("short.lut", bytes.substr(0, bytes.size() - 7))), Error);
-  EXPECT_THROW(read_transport_table(write("text.lut", "{\"format\": \"lucent-material\"}\n")), Error);
+  EXPECT_THROW(read_transport_table(write("text.lut", "{\"format\": \"lucent-material\"}\n")),
+               Error);
   EXPECT_THROW(read_transport_table(write("empty.lut", "")), Error);
   EXPECT_THROW(read_transport_table(dir / "missing.lut"), Error);
   fs::remove_all(dir);
@@ -206,7 +212,7 @@ TEST(TransportTableFile, RoundTripsAndRejectsDamage) {
 
 TEST(TransportTableFile, MergeJoinsDisjointSlicesAndRefusesDuplicates) {
   TransportTable a = synthetic_table(), b = synthetic_table();
-  a.slices.resize(1), a.slice_axes.resize(1);            // eta 1.0
+  a.slices.resize(1), a.slice_axes.resize(1);                                  // eta 1.0
   b.slices.erase(b.slices.begin()), b.slice_axes.erase(b.slice_axes.begin());  // 1.3, 1.6
   const TransportTable m = merge_transport_tables({b, a});
   ASSERT_EQ(m.slices.size(), 3u);
@@ -247,6 +253,54 @@ TEST(TabulatedModel, ShippedTableStaysFiniteAtEveryExtreme) {
 
 TEST(TabulatedProfile, RefusesAGOutsideTheTable) {
   EXPECT_THROW(TabulatedProfile(synthetic_table(), 0.5), Error);
+}
+
+// A slice a fit built for exactly (eta, g) and kept in the cache is what everything outside the fit
+// (lucent profile, the renderers) uses for a material of that (g, eta); without one, a tabulated
+// material whose g the shipped table lacks renders with its adequate model.
+TEST(RadialSlices, CachedSliceServesItsGAndEtaAndTheAdequateModelStandsIn) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("lucent_slice_cache_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  TransportTable t = synthetic_table();
+  t.slices.resize(1), t.slice_axes.resize(1);
+  t.slices[0].eta = 1.45, t.slices[0].g = 0.97;
+  t.slice_axes[0] = {1.45, 0.97, 1000.0, 0.0, 0.0};  // eta, g, photons, incidence, white
+  write_transport_table(t, dir / radial_slice_file_name(1.45, 0.97, 1000));
+  const char* before = std::getenv("LUCENT_CACHE_DIR");
+  const std::string saved = before ? before : "";
+  ::setenv("LUCENT_CACHE_DIR", dir.c_str(), 1);
+
+  const auto p = radial_profile_for(0.97, 1.45);
+  EXPECT_EQ(p->g(), 0.97);
+  EXPECT_EQ(p->eta_min(), 1.45);
+  EXPECT_THROW(radial_profile_for(0.97, 1.5), Error);  // that slice's eta only
+  try {
+    radial_profile_for(0.96, 1.45);
+    ADD_FAILURE() << "g 0.96: no table holds it";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("g: 0.96 (the material's)"), std::string::npos)
+        << e.what();
+  }
+  Material m;
+  m.name = "cached";
+  m.ior = 1.45;
+  m.sigma_a = {0.1, 0.1, 0.1};
+  m.sigma_s_reduced = {0.03, 0.03, 0.03};
+  m.sigma_s = Rgb{1, 1, 1};
+  m.g = Rgb{0.97, 0.97, 0.97};
+  m.model = "tabulated";
+  m.adequate_model = "dipole";
+  EXPECT_EQ(preferred_model(m), DiffusionModel::kTabulated);
+  m.sigma_s = Rgb{0.75, 0.75, 0.75};
+  m.g = Rgb{0.96, 0.96, 0.96};
+  EXPECT_EQ(preferred_model(m), DiffusionModel::kDipole);
+
+  if (before)
+    ::setenv("LUCENT_CACHE_DIR", saved.c_str(), 1);
+  else
+    ::unsetenv("LUCENT_CACHE_DIR");
+  fs::remove_all(dir);
 }
 
 }  // namespace
