@@ -12,7 +12,7 @@
 #include "lucent/materials/error.h"
 #include "lucent/materials/json_file.h"
 #include "lucent/materials/transport_table.h"
-#include "oblique_table.h"
+#include "fit_tables.h"
 #include "progress.h"
 #include "validators.h"
 

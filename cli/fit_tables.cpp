@@ -1,5 +1,5 @@
-// Finding or building the oblique slice of a fit (oblique_table.h).
-#include "oblique_table.h"
+// Finding or building the tables a fit needs beyond the shipped ones (fit_tables.h).
+#include "fit_tables.h"
 
 #include <algorithm>
 #include <cmath>
