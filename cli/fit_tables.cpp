@@ -160,6 +160,7 @@ const materials::TransportTable* radial_table_for(const std::vector<fit::Profile
                                std::uint64_t(o.groups) * 64, photons);
   // Kept for the process (a batch's rows of one (eta, g) share it; the prepared profiles are keyed
   // by the table's address, which must not be reused by another table).
+  // (Batch rows run one after another: no lock.)
   static std::map<std::string, const materials::TransportTable*> kept;
   const std::string name = materials::radial_slice_file_name(*eta, g, photons);
   if (const auto it = kept.find(name); it != kept.end()) return it->second;

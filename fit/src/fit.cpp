@@ -449,7 +449,12 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
             options.table ? *options.table : materials::default_transport_table(), g_other,
             eta_held);
       } catch (const Error&) {
-        if (!options.table) throw;
+        // Only for a slice built for this g (one g in the table); a table the user gave stands.
+        bool one_g = options.table != nullptr;
+        if (one_g)
+          for (const materials::TransportTableSlice& s : options.table->slices)
+            one_g = one_g && s.g == options.table->slices.front().g;
+        if (!one_g) throw;
         other_profile = materials::cached_tabulated_profile(materials::default_transport_table(),
                                                             g_other, eta_held);
       }

@@ -110,7 +110,10 @@ materials::Material fitted_material(const FitResult& result, const std::vector<P
   m.adequate_model = result.adequate_model;
   // A tabulated fit at an assumed g > 0 measured that medium: the file says so (sigma_s and g
   // beside sigma_s'), so that lucent profile and the renderers evaluate the model at the same g.
-  const bool anisotropic = f.model == FitModel::kTabulated && result.g > 0;
+  // (Not when sigma_s would pass the 1e6 mm^-1 a material file may hold: sigma_s' alone then.)
+  bool anisotropic = f.model == FitModel::kTabulated && result.g > 0 && result.g < 1;
+  for (int c = 0; anisotropic && c < 3; ++c)
+    anisotropic = f.channels[c].sigma_s_reduced / (1 - result.g) <= 1e6;
   if (anisotropic) {
     m.g = materials::Rgb{result.g, result.g, result.g};
     m.sigma_s = materials::Rgb{};

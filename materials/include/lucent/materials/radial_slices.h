@@ -16,8 +16,9 @@ namespace lucent::materials {
 /// The cache file's name of the slice at (eta, g) built with `photons` photons per albedo node.
 std::string radial_slice_file_name(double eta, double g, std::uint64_t photons);
 
-/// The cached slice at exactly (eta, g) of the most photons, read once per process and kept for
-/// it; nullptr when the cache holds none (or none readable).
+/// The cached slice at exactly (eta, g) of the most photons that reads, looked up once per process
+/// (a slice built later in the same process is not seen) and kept for it; nullptr when the cache
+/// holds none.
 const TransportTable* cached_radial_slice(double eta, double g);
 
 /// Keeps a table for the rest of the process: a stable address, which cached_tabulated_profile
@@ -26,7 +27,7 @@ const TransportTable* cached_radial_slice(double eta, double g);
 const TransportTable& keep_transport_table(TransportTable table);
 
 /// The prepared profile a tabulated model of (g, eta) uses: the cached slice at exactly (eta, g)
-/// when a fit built one (what that fit used), else the shipped table at g (a node, or C1 in g
+/// when a fit built one, else the shipped table at g (a node, or C1 in g
 /// between nodes), at eta. Throws lucent::Error like cached_tabulated_profile when neither holds
 /// it.
 std::shared_ptr<const TabulatedProfile> radial_profile_for(double g, double eta);
