@@ -116,7 +116,8 @@ materials::TransportTableGrid radial_fit_grid() {
 const materials::TransportTable* radial_table_for(const std::vector<fit::ProfileData>& data,
                                                   const fit::FitOptions& options,
                                                   std::uint64_t photons, bool quiet) {
-  if (options.fit_ior || options.model == fit::FitModel::kDipole ||
+  // A table given with --table is the user's choice (its refusal of a g it lacks stands).
+  if (options.table || options.fit_ior || options.model == fit::FitModel::kDipole ||
       options.model == fit::FitModel::kDirectionalDipole)
     return nullptr;
   for (const fit::ProfileData& d : data) {
@@ -140,9 +141,7 @@ const materials::TransportTable* radial_table_for(const std::vector<fit::Profile
     }
     return *eta >= eta_min - 1e-9 && *eta <= eta_max + 1e-9;
   };
-  // A table given with --table is the user's choice (its refusal of a g it lacks stands), and a
-  // shipped table that cannot be read is the fit's to report.
-  if (options.table) return nullptr;
+  // A shipped table that cannot be read is the fit's to report.
   try {
     if (has(materials::default_transport_table())) return nullptr;
   } catch (const Error&) {

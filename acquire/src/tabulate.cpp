@@ -58,9 +58,9 @@ struct SliceConstants {
   double eta = 1, g = 0;
   double incidence = 0;         // degrees, outside
   double sin_t = 0, cos_t = 1;  // the refracted beam's direction: (sin_t, 0, -cos_t)
-  double sigma_s = 1;           // white medium, units of sigma_s' = 1
-  double eta_out = 1;           // 1 / eta
-  double nee_factor = 1;        // T(normal, going out) / eta^2
+  double sigma_s = 1;     // white medium, units of sigma_s' = 1
+  double eta_out = 1;     // 1 / eta
+  double nee_factor = 1;  // T(normal, going out) / eta^2
   HenyeyGreenstein hg;
 };
 
@@ -178,8 +178,8 @@ ForcedEscape forced_escape(const SliceConstants& s, const Walk& m, const std::ar
 // One (slice, group) unit: the white run for the nodes of alpha' >= kDirectBelowAlbedo, a direct
 // (absorbing) run for each node below it.
 void trace_group(const SliceConstants& s, const std::vector<AlbedoNode>& nodes,
-                 const materials::TransportTableGrid& grid, double max_path, std::uint64_t photons,
-                 std::uint64_t white_photons, Xoshiro256StarStar& rng,
+                 const materials::TransportTableGrid& grid, double max_path,
+                 std::uint64_t photons, std::uint64_t white_photons, Xoshiro256StarStar& rng,
                  materials::TransportTableGroup& out, std::atomic<std::uint64_t>& done) {
   const int J = grid.rho_bins();
   const int P = grid.phi_bins;
@@ -280,9 +280,7 @@ void trace_group(const SliceConstants& s, const std::vector<AlbedoNode>& nodes,
 
   // Means per photon, per unit area of the real medium's annuli (or wedges of them, both sides
   // of y = 0: 1 / P of the annulus); pi L for the radiance.
-  const auto traced = [&](std::size_t k) {
-    return double(k < white_nodes ? white_photons : photons);
-  };
+  const auto traced = [&](std::size_t k) { return double(k < white_nodes ? white_photons : photons); };
   for (std::size_t row = 0; row < grid.rows(); ++row) {
     const double n = traced(row / std::size_t(P));
     for (int j = 0; j < J; ++j) {
@@ -320,8 +318,7 @@ void validate_tabulate_options(const TabulateOptions& o) {
     if (!(o.g[i] > o.g[i - 1])) bad("--g: the values must be strictly increasing");
   if (o.grid.u.size() < 2 || o.grid.u.front() != 0.0) bad("grid: u nodes must start at 0");
   for (std::size_t i = 1; i < o.grid.u.size(); ++i)
-    if (!(o.grid.u[i] > o.grid.u[i - 1] && o.grid.u[i] < 1))
-      bad("grid: u nodes must rise in [0, 1)");
+    if (!(o.grid.u[i] > o.grid.u[i - 1] && o.grid.u[i] < 1)) bad("grid: u nodes must rise in [0, 1)");
   if (!(o.grid.rho_min > 0 && o.grid.rho_max > o.grid.rho_min && o.grid.rho_per_decade >= 1 &&
         o.grid.rho_per_decade <= 200))
     bad("grid: rho range or bins per decade out of range");
@@ -348,33 +345,31 @@ materials::TransportTable tabulate_transport(const TabulateOptions& o,
   table.generator = std::string("lucent ") + kVersion;
   for (double a : o.incidence_deg)
     if (a != 0) table.single_scattering_line_excluded = true;
-  const std::uint64_t per_group =
-      (o.photons + std::uint64_t(o.groups) - 1) / std::uint64_t(o.groups);
+  const std::uint64_t per_group = (o.photons + std::uint64_t(o.groups) - 1) / std::uint64_t(o.groups);
   const std::uint64_t white_per_group =
-      o.white_photons > 0
-          ? (o.white_photons + std::uint64_t(o.groups) - 1) / std::uint64_t(o.groups)
-          : per_group;
+      o.white_photons > 0 ? (o.white_photons + std::uint64_t(o.groups) - 1) / std::uint64_t(o.groups)
+                          : per_group;
 
   std::vector<SliceConstants> slices;
   for (double incidence : o.incidence_deg) {
-    for (double g : o.g) {
-      for (double eta : o.eta) {
-        SliceConstants s;
-        s.eta = eta;
-        s.g = g;
-        s.incidence = incidence;
-        s.sin_t = std::sin(incidence * std::numbers::pi / 180) / eta;
-        s.cos_t = std::sqrt(1 - s.sin_t * s.sin_t);
-        s.sigma_s = 1.0 / (1.0 - g);
-        s.eta_out = 1.0 / eta;
-        s.nee_factor = materials::fresnel_transmittance(1.0, s.eta_out) / (eta * eta);
-        s.hg = HenyeyGreenstein(g);
-        slices.push_back(s);
-        table.slice_axes.push_back(
-            {eta, g, double(per_group * std::uint64_t(o.groups)), incidence,
-             o.white_photons > 0 ? double(white_per_group * std::uint64_t(o.groups)) : 0.0});
-      }
+  for (double g : o.g) {
+    for (double eta : o.eta) {
+      SliceConstants s;
+      s.eta = eta;
+      s.g = g;
+      s.incidence = incidence;
+      s.sin_t = std::sin(incidence * std::numbers::pi / 180) / eta;
+      s.cos_t = std::sqrt(1 - s.sin_t * s.sin_t);
+      s.sigma_s = 1.0 / (1.0 - g);
+      s.eta_out = 1.0 / eta;
+      s.nee_factor = materials::fresnel_transmittance(1.0, s.eta_out) / (eta * eta);
+      s.hg = HenyeyGreenstein(g);
+      slices.push_back(s);
+      table.slice_axes.push_back({eta, g, double(per_group * std::uint64_t(o.groups)), incidence,
+                                  o.white_photons > 0 ? double(white_per_group * std::uint64_t(o.groups))
+                                                      : 0.0});
     }
+  }
   }
   std::vector<AlbedoNode> nodes;
   for (double u : o.grid.u) {

@@ -86,10 +86,9 @@ json g_systematic_json(const FitResult& r) {
           {"other_g", r.g_other},
           {"shift_sigma_a", shift_a},
           {"shift_sigma_s_reduced", shift_s},
-          {"note",
-           "radial normal-incidence data cannot separate g from sigma_s: the fit at "
-           "other_g moves by these amounts (mm^-1); not in the total, which holds for "
-           "the assumed g"}};
+          {"note", "radial normal-incidence data cannot separate g from sigma_s: the fit at "
+                   "other_g moves by these amounts (mm^-1); not in the total, which holds for "
+                   "the assumed g"}};
 }
 
 json inputs_json(const std::vector<ProfileData>& data) {
@@ -141,8 +140,7 @@ materials::Material fitted_material(const FitResult& result, const std::vector<P
       {"correlation_sigma_a_sigma_s_reduced", corr},
       {"kind",
        "one standard deviation, mm^-1: total = statistical (Jacobian at the solution, "
-       "calibration prior included, scaled by the root of the reduced chi^2 or, for pixels, the "
-       "design effect, when above 1) and "
+       "calibration prior included, scaled by the root of the reduced chi^2 or, for pixels, the design effect, when above 1) and "
        "systematic "
        "(the model's own error: a diffusion model's difference from the tabulated model on the "
        "same data) in quadrature"}};

@@ -72,9 +72,8 @@ DiffusionModel parse_diffusion_model(const std::string& name, const std::string&
   if (name == "ddipole") return DiffusionModel::kDirectionalDipole;
   if (name == "tabulated" && allow_tabulated) return DiffusionModel::kTabulated;
   if (name == "tabulated")
-    throw Error(option +
-                ": 'tabulated' is radial only (normal incidence on a plane); expected "
-                "'dipole' or 'ddipole' here");
+    throw Error(option + ": 'tabulated' is radial only (normal incidence on a plane); expected "
+                         "'dipole' or 'ddipole' here");
   throw Error(option + ": expected 'dipole', 'ddipole'" +
               std::string(allow_tabulated ? " or 'tabulated'" : "") + ", got '" + name + "'");
 }
@@ -152,9 +151,8 @@ std::vector<double> parse_radius_range(const std::string& text, const std::strin
 std::array<double, 3> evaluate_bssrdf(const Material& material, DiffusionModel model,
                                       const BssrdfConfig& c) {
   if (model == DiffusionModel::kTabulated)
-    throw Error(
-        "--configs: the tabulated model is radial only (normal incidence on a plane); "
-        "use --r or --r-range");
+    throw Error("--configs: the tabulated model is radial only (normal incidence on a plane); "
+                "use --r or --r-range");
   std::array<double, 3> S{};
   for (int channel = 0; channel < 3; ++channel) {
     const Medium<double> medium = material.medium(channel);
@@ -178,12 +176,12 @@ double radial_profile_value(const Material& material, int channel, DiffusionMode
     }
     case DiffusionModel::kDirectionalDipole: {
       const DirectionalDipole<double> ddipole(medium);
-      const double pi_s =
-          std::numbers::pi * ddipole.S_d(Vec3<double>::Zero(), plane_normal(), plane_normal(),
-                                         Vec3<double>(r, 0.0, 0.0), plane_normal());
-      return pi_s * (radiance
-                         ? fresnel_transmittance(1.0, medium.eta)
-                         : medium.eta * medium.eta * (1 - diffuse_fresnel_reflectance(medium.eta)));
+      const double pi_s = std::numbers::pi * ddipole.S_d(Vec3<double>::Zero(), plane_normal(),
+                                                         plane_normal(), Vec3<double>(r, 0.0, 0.0),
+                                                         plane_normal());
+      return pi_s * (radiance ? fresnel_transmittance(1.0, medium.eta)
+                              : medium.eta * medium.eta *
+                                    (1 - diffuse_fresnel_reflectance(medium.eta)));
     }
     case DiffusionModel::kTabulated: {
       // Materials with sigma_s and g carry their own g per channel.
@@ -198,15 +196,15 @@ std::string radial_profile_csv(const Material& material, const RadialProfileOpti
   std::ostringstream out;
   out << "# format=lucent-radial-profile version=1 quantity=" << to_string(options.quantity)
       << " ior=" << format_input(material.ior) << " model=" << to_string(options.model)
-      << " incidence_deg=0 units=mm^-2_per_unit_power_entering material=" << material.name << "\n";
+      << " incidence_deg=0 units=mm^-2_per_unit_power_entering material=" << material.name
+      << "\n";
   std::ostringstream rows;
   rows << "r_mm,R_r,R_g,R_b\n";
   for (double r : options.r_mm) {
     rows << format_input(r);
     for (int channel = 0; channel < 3; ++channel)
-      rows << ','
-           << format_number(
-                  radial_profile_value(material, channel, options.model, options.quantity, r));
+      rows << ',' << format_number(radial_profile_value(material, channel, options.model,
+                                                        options.quantity, r));
     rows << '\n';
   }
   if (options.total) {

@@ -47,27 +47,22 @@ TabulatedChannelData tabulated_channel_data(const materials::Medium<double>& med
 void set_tabulated(GLuint program, const materials::Material& material, GLuint texture_unit,
                    Texture& rows) {
   std::array<TabulatedChannelData, 3> channels;
-  for (int c = 0; c < 3; ++c)
-    channels[std::size_t(c)] = tabulated_channel_data(material.medium(c), c);
+  for (int c = 0; c < 3; ++c) channels[std::size_t(c)] = tabulated_channel_data(material.medium(c), c);
   const int J = channels[0].nodes;
   std::vector<float> texels(std::size_t(J) * 3, 0.0f);
   for (int c = 0; c < 3; ++c) {
-    if (channels[std::size_t(c)].nodes != J)
-      throw Error("tabulated model: channels' tables differ in size");
-    std::copy(channels[std::size_t(c)].log_values.begin(),
-              channels[std::size_t(c)].log_values.end(), texels.begin() + std::ptrdiff_t(c) * J);
+    if (channels[std::size_t(c)].nodes != J) throw Error("tabulated model: channels' tables differ in size");
+    std::copy(channels[std::size_t(c)].log_values.begin(), channels[std::size_t(c)].log_values.end(),
+              texels.begin() + std::ptrdiff_t(c) * J);
   }
   rows = create_texture(GL_TEXTURE_2D);
   glTextureStorage2D(rows.id(), 1, GL_R32F, J, 3);
   glTextureSubImage2D(rows.id(), 0, 0, 0, J, 3, GL_RED, GL_FLOAT, texels.data());
-  glProgramUniform1i(program, glGetUniformLocation(program, "u_tabulated_rows"),
-                     GLint(texture_unit));
+  glProgramUniform1i(program, glGetUniformLocation(program, "u_tabulated_rows"), GLint(texture_unit));
   for (int c = 0; c < 3; ++c) {
     const TabulatedChannelData& d = channels[std::size_t(c)];
     const std::string n = "u_tabulated[" + std::to_string(c) + "].";
-    const auto loc = [&](const char* field) {
-      return glGetUniformLocation(program, (n + field).c_str());
-    };
+    const auto loc = [&](const char* field) { return glGetUniformLocation(program, (n + field).c_str()); };
     glProgramUniform1f(program, loc("sigma_t"), d.sigma_t);
     glProgramUniform1f(program, loc("scale"), d.scale);
     glProgramUniform1f(program, loc("x0"), d.x0);

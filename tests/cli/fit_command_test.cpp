@@ -210,8 +210,8 @@ TEST_P(FitBundledCapture, RecoversTheTruthWithinItsTotalUncertainty) {
   const fs::path dir = scratch_dir(std::string("fit-sample-") + c.capture);
   const std::string capture =
       std::string(LUCENT_SOURCE_DIR) + "/notebooks_data/captures/" + c.capture;
-  const auto a =
-      run_lucent("acquire \"" + capture + "/capture.json\" -o \"" + (dir / "acq").string() + "\"");
+  const auto a = run_lucent("acquire \"" + capture + "/capture.json\" -o \"" +
+                            (dir / "acq").string() + "\"");
   ASSERT_EQ(a.exit_code, 0) << a.err;
   const auto f = run_lucent("fit \"" + (dir / "acq" / "profile.json").string() + "\" -o \"" +
                             (dir / "m.json").string() + "\"");
@@ -227,8 +227,8 @@ TEST_P(FitBundledCapture, RecoversTheTruthWithinItsTotalUncertainty) {
     for (const char* key : {"sigma_a", "sigma_s_reduced"}) {
       const double t = truth[key][ch], v = m[key][ch], sd = m["uncertainty"][key][ch];
       EXPECT_LT(std::abs(v / t - 1), c.max_error) << c.capture << " " << key << "[" << ch << "]";
-      EXPECT_LT(std::abs(v - t), c.max_z * sd)
-          << c.capture << " " << key << "[" << ch << "] " << v << " +- " << sd << " truth " << t;
+      EXPECT_LT(std::abs(v - t), c.max_z * sd) << c.capture << " " << key << "[" << ch << "] "
+                                               << v << " +- " << sd << " truth " << t;
     }
   }
   fs::remove_all(dir);
@@ -263,11 +263,10 @@ TEST(FitObliqueCapture, BuildsTheMissingSliceOnceAndFitsWithIt) {
                        " --photons 300000 --size 48 --pixel-mm 0.25 --incidence-deg 30 --seed 4")
                 .exit_code,
             0);
-  ASSERT_EQ(
-      run_lucent("acquire " + q(dir / "sim" / "capture.json") + " -o " + q(dir / "acq")).exit_code,
-      0);
-  const std::string fit =
-      "fit " + q(dir / "acq" / "profile.json") + " --oblique-photons 50000 --quality fast -o ";
+  ASSERT_EQ(run_lucent("acquire " + q(dir / "sim" / "capture.json") + " -o " + q(dir / "acq"))
+                .exit_code,
+            0);
+  const std::string fit = "fit " + q(dir / "acq" / "profile.json") + " --oblique-photons 50000 --quality fast -o ";
   const auto first = run_lucent(fit + q(dir / "m1.json"));
   ASSERT_EQ(first.exit_code, 0) << first.err;
   EXPECT_NE(first.err.find("building the oblique transport table for eta 1.3, g 0, incidence 30"),

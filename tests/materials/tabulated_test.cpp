@@ -7,9 +7,9 @@
 #include <ceres/jet.h>
 
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <cstdio>
 #include <random>
 
 #include "lucent/materials/error.h"
@@ -112,8 +112,7 @@ TransportTable synthetic_table() {
           double avg = 0;
           for (int m = 0; m < 200; ++m) {
             const double r = std::sqrt(r0 * r0 + (m + 0.5) / 200 * (r1 * r1 - r0 * r0));
-            avg += (1 - t.grid.u[k] * t.grid.u[k]) * std::exp(-2 * t.grid.u[k] * r + eta) /
-                   (r + 0.1) * (q + 1) / 200;
+            avg += (1 - t.grid.u[k] * t.grid.u[k]) * std::exp(-2 * t.grid.u[k] * r + eta) / (r + 0.1) * (q + 1) / 200;
           }
           s.value[std::size_t(q)].push_back(float(std::max(avg, 1e-37)));  // as the writer clamps
           s.se_code[std::size_t(q)].push_back(encode_relative_se(0.01, false));
@@ -170,8 +169,7 @@ TEST(TabulatedProfile, FiniteAtTheExtremes) {
 }
 
 TEST(TransportTableFile, RoundTripsAndRejectsDamage) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("lucent_table_test_" + std::to_string(::getpid()));
+  const fs::path dir = fs::temp_directory_path() / ("lucent_table_test_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const TransportTable t = synthetic_table();
   write_transport_table(t, dir / "t.lut");
@@ -203,8 +201,7 @@ TEST(TransportTableFile, RoundTripsAndRejectsDamage) {
       },
       Error);
   EXPECT_THROW(read_transport_table(write("short.lut", bytes.substr(0, bytes.size() - 7))), Error);
-  EXPECT_THROW(read_transport_table(write("text.lut", "{\"format\": \"lucent-material\"}\n")),
-               Error);
+  EXPECT_THROW(read_transport_table(write("text.lut", "{\"format\": \"lucent-material\"}\n")), Error);
   EXPECT_THROW(read_transport_table(write("empty.lut", "")), Error);
   EXPECT_THROW(read_transport_table(dir / "missing.lut"), Error);
   fs::remove_all(dir);
@@ -212,7 +209,7 @@ TEST(TransportTableFile, RoundTripsAndRejectsDamage) {
 
 TEST(TransportTableFile, MergeJoinsDisjointSlicesAndRefusesDuplicates) {
   TransportTable a = synthetic_table(), b = synthetic_table();
-  a.slices.resize(1), a.slice_axes.resize(1);                                  // eta 1.0
+  a.slices.resize(1), a.slice_axes.resize(1);            // eta 1.0
   b.slices.erase(b.slices.begin()), b.slice_axes.erase(b.slice_axes.begin());  // 1.3, 1.6
   const TransportTable m = merge_transport_tables({b, a});
   ASSERT_EQ(m.slices.size(), 3u);

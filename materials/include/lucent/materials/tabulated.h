@@ -106,12 +106,8 @@ NodeWeights<T> hermite_weights(const std::vector<double>& x, const T& t, bool ex
 }
 
 /// The value of a scalar or of a Jet's real part (for choosing a cell; never differentiated).
-inline double scalar_of(double v) {
-  return v;
-}
-inline double scalar_of(float v) {
-  return v;
-}
+inline double scalar_of(double v) { return v; }
+inline double scalar_of(float v) { return v; }
 template <typename T>
 double scalar_of(const T& v) {
   return v.a;
@@ -272,8 +268,7 @@ class TabulatedProfile {
     T sum(0);
     for (int a = 0; a < we.count; ++a)
       for (int b = 0; b < wu.count; ++b)
-        sum +=
-            we.w[a] * wu.w[b] * T(log_total_[std::size_t(we.first + a)][std::size_t(wu.first + b)]);
+        sum += we.w[a] * wu.w[b] * T(log_total_[std::size_t(we.first + a)][std::size_t(wu.first + b)]);
     return alpha_prime * exp(sum);
   }
 
@@ -293,7 +288,7 @@ class TabulatedProfile {
   // [slice][quantity][k * J + j]
   std::vector<std::array<std::vector<double>, kTableQuantities>> f_;
   std::vector<std::array<std::vector<float>, kTableQuantities>> rel_se_;
-  std::vector<std::vector<double>> log_total_;     // [slice][k]: log(total / alpha')
+  std::vector<std::vector<double>> log_total_;  // [slice][k]: log(total / alpha')
   std::vector<std::vector<double>> total_rel_se_;  // [slice][k]
   std::shared_ptr<const ObliqueProfile> oblique_;
 };
@@ -356,11 +351,14 @@ class TabulatedModel {
     const T rho = r_mm * sigma_t_reduced_;
     const T floor(1e-12);
     using std::exp;
-    return S_d_scale() * exp(profile_->row_log_value(rows_[std::size_t(TableQuantity::kRadiance)],
-                                                     rho > floor ? rho : floor));
+    return S_d_scale() *
+           exp(profile_->row_log_value(rows_[std::size_t(TableQuantity::kRadiance)],
+                                       rho > floor ? rho : floor));
   }
   /// S_d = S_d_scale() e^(row(ln rho)) with row = log_row(kRadiance): what the GLSL twin uploads.
-  T S_d_scale() const { return scale_ / (T(std::numbers::pi) * fresnel_transmittance(T(1), eta_)); }
+  T S_d_scale() const {
+    return scale_ / (T(std::numbers::pi) * fresnel_transmittance(T(1), eta_));
+  }
   /// The model's row of log(value / (sigma_t'^2 alpha')) over TabulatedProfile::log_rho_nodes().
   const std::vector<T>& log_row(TableQuantity q) const { return rows_[std::size_t(q)]; }
   T total_diffuse_reflectance() const {
