@@ -181,8 +181,15 @@ materials::Material run(const FitArguments& a) {
     }
     std::cout << " (radial data cannot tell g from sigma_s)\n";
   }
-  if (!result.adequate_model.empty())
-    std::cout << "  cheapest adequate model for rendering: " << result.adequate_model << '\n';
+  if (result.adequate_model == "none")
+    std::cout << "  no cheaper model is adequate (within "
+              << 100 * fit::ModelAdequacy::kBar << "% of the " << fit::to_string(f.model)
+              << " profile over most of the data); without its table a renderer uses "
+              << result.fallback_model << ", the closest\n";
+  else if (!result.adequate_model.empty())
+    std::cout << "  cheapest adequate model for rendering (within "
+              << 100 * fit::ModelAdequacy::kBar << "% of the " << fit::to_string(f.model)
+              << " profile): " << result.adequate_model << '\n';
   for (const std::string& note : result.notes) std::cout << "  note: " << note << '\n';
   for (const std::string& w : result.warnings) warn("lucent fit: warning: " + w);
   std::cout << "wrote " << a.output << '\n';

@@ -325,10 +325,40 @@ void write_profile(const std::filesystem::path& path, const Profile& profile) {
 }
 
 std::string profile_csv(const Profile& profile) {
-  std::string out = "r_mm,R_r,R_g,R_b,se_r,se_g,se_b,n_r,n_g,n_b\n";
+  // The one radial CSV schema (lucent fit's reader, README "Radial CSV"): every comment token is
+  // key=value; what the JSON says of the geometry and the calibration is said here too, so that a
+  // fit of this file equals a fit of profile.json.
+  std::string out = "# format=lucent-radial-csv version=1 source=lucent_acquire\n";
+  out += "# quantity=radiance R_unit=";
+  out += profile.calibrated ? "mm^-2_per_unit_incident_power" : "relative_per_unit_incident_power";
+  out += " calibrated=";
+  out += profile.calibrated ? "true" : "false";
+  out += "\n";
+  out += "# incidence_deg=" + format_number(profile.incidence_polar_deg) +
+         " view_deg=" + format_number(profile.view_deg) +
+         " pixel_mm=" + format_number(profile.pixel_pitch_mm);
+  if (profile.ior) out += " ior=" + format_number(*profile.ior);
+  out += "\n";
+  if (profile.beam_power && profile.provenance.contains("white_reference")) {
+    const json& white = profile.provenance["white_reference"];
+    if (white.is_object() && white.contains("beam_power_standard_error") &&
+        white["beam_power_standard_error"].is_array() &&
+        white["beam_power_standard_error"].size() == 3) {
+      std::string se;
+      for (int c = 0; c < 3; ++c) {
+        const json& v = white["beam_power_standard_error"][c];
+        const double power = (*profile.beam_power)[c];
+        se += (c ? "," : "") +
+              format_number(v.is_number() && power > 0 ? v.get<double>() / power : 0.0);
+      }
+      out += "# calibration_relative_se=" + se + "\n";
+    }
+  }
+  out += "r_mm,r_inner_mm,r_outer_mm,R_r,R_g,R_b,se_r,se_g,se_b,n_r,n_g,n_b\n";
   const RadialProfile& r = profile.radial;
   for (std::size_t i = 0; i < r.size(); ++i) {
     out += format_number(r.r_mm[i]);
+    out += "," + format_number(r.r_inner_mm[i]) + "," + format_number(r.r_outer_mm[i]);
     for (int c = 0; c < 3; ++c) out += "," + format_number(r.value[c][i]);
     for (int c = 0; c < 3; ++c) out += "," + format_number(r.standard_error[c][i]);
     for (int c = 0; c < 3; ++c) out += "," + std::to_string(r.count[c][i]);

@@ -108,6 +108,35 @@ ProfileData parse_profile_csv(std::string_view text, const std::string& source) 
   }
   if (auto it = meta.find("R_unit"); it != meta.end())
     d.per_incident_power = it->second.find("per_unit_incident_power") != std::string::npos;
+  if (auto it = meta.find("calibrated"); it != meta.end()) {
+    if (it->second != "true" && it->second != "false")
+      throw Error(source + ": comment field calibrated=" + it->second + ": expected true or false");
+    d.calibrated = it->second == "true";
+  }
+  if (auto view = meta_number("view_deg")) {
+    if (!(*view >= 0 && *view < 90))
+      throw Error(source + ": comment field view_deg: expected [0, 90) degrees");
+    d.view_deg = *view;
+  }
+  if (auto pixel = meta_number("pixel_mm")) {
+    if (!(*pixel >= 0 && *pixel < 1e3))
+      throw Error(source + ": comment field pixel_mm: expected a pixel side in [0, 1000) mm");
+    d.radial.pixel_mm = *pixel;
+  }
+  if (auto it = meta.find("calibration_relative_se"); it != meta.end()) {
+    const std::vector<std::string> parts = split(it->second);
+    if (parts.size() != 3)
+      throw Error(source + ": comment field calibration_relative_se=" + it->second +
+                  ": expected three numbers (R,G,B) >= 0");
+    for (int c = 0; c < 3; ++c) {
+      double v = 0;
+      const auto [end, ec] = std::from_chars(parts[c].data(), parts[c].data() + parts[c].size(), v);
+      if (ec != std::errc() || end != parts[c].data() + parts[c].size() || !(v >= 0 && v < 1))
+        throw Error(source + ": comment field calibration_relative_se=" + it->second +
+                    ": expected three numbers (R,G,B) in [0, 1)");
+      d.calibration_relative_se[c] = v;
+    }
+  }
   if (auto incidence = meta_number("incidence_deg")) {
     if (!(*incidence >= 0 && *incidence < 90))
       throw Error(source + ": comment field incidence_deg: expected [0, 90) degrees");

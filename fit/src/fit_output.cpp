@@ -34,6 +34,7 @@ json model_fit_json(const ModelFit& f) {
                         {"sd_sys_sigma_s_reduced", finite_or_null(c.sd_sys_sigma_s_reduced)},
                         {"reduced_chi2", finite_or_null(c.reduced_chi2)},
                         {"design_effect", finite_or_null(c.design_effect)},
+                        {"structure_z", finite_or_null(c.structure_z)},
                         {"exclude_radius_mm", finite_or_null(c.exclude_radius_mm)},
                         {"range_end_mm", finite_or_null(c.range_end_mm)},
                         {"range_diffusion_lengths", finite_or_null(c.range_diffusion_lengths)},
@@ -68,9 +69,10 @@ json adequacy_json(const FitResult& r) {
   json a = json::array();
   for (const ModelAdequacy& m : r.adequacy)
     a.push_back({{"model", name_of(m.model)},
-                 {"tolerance", m.tolerance},
-                 {"within_tolerance_beyond_mm", finite_or_null(m.beyond_mm)},
-                 {"max_deviation", finite_or_null(m.max_deviation)},
+                 {"bar_percent", 100 * ModelAdequacy::kBar},
+                 {"within_percent", 100 * m.tolerance},
+                 {"within_percent_beyond_mm", finite_or_null(m.beyond_mm)},
+                 {"max_deviation_percent", finite_or_null(100 * m.max_deviation)},
                  {"adequate", m.adequate}});
   return a;
 }
@@ -107,6 +109,7 @@ materials::Material fitted_material(const FitResult& result, const std::vector<P
   m.ior = f.eta;
   m.model = name_of(f.model);
   m.adequate_model = result.adequate_model;
+  m.fallback_model = result.fallback_model;
   // A tabulated fit at an assumed g > 0 measured that medium: the file says so (sigma_s and g
   // beside sigma_s'), so that lucent profile and the renderers evaluate the model at the same g.
   // (Not when sigma_s would pass the 1e6 mm^-1 a material file may hold: sigma_s' alone then.)
@@ -165,6 +168,7 @@ materials::Material fitted_material(const FitResult& result, const std::vector<P
                     {"g", result.g},
                     {"g_systematic", g_systematic_json(result)},
                     {"adequate_model", result.adequate_model},
+                    {"fallback_model", result.fallback_model},
                     {"adequacy", adequacy_json(result)},
                     {"warnings", result.warnings},
                     {"notes", result.notes}}}};
@@ -189,6 +193,7 @@ json fit_report(const FitResult& result, const std::vector<ProfileData>& data,
           {"g", result.g},
           {"g_systematic", g_systematic_json(result)},
           {"adequate_model", result.adequate_model},
+          {"fallback_model", result.fallback_model},
           {"adequacy", adequacy_json(result)},
           {"tool", std::string("lucent fit ") + kVersion}};
 }

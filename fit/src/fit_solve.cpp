@@ -1,6 +1,7 @@
 // The Ceres problem of a fit: the solve over the residuals of fit_residuals.h, the covariance and
 // per-channel statistics (fit_solve.h).
 #include "fit_solve.h"
+#include "lack_of_fit.h"
 
 #include <ceres/ceres.h>
 #include <ceres/covariance.h>
@@ -473,6 +474,27 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
     fit.converged = false;
     fit.message = why.str();
     break;
+  }
+  // The accurate model is transport in a semi-infinite sample under a pencil beam: runs of one sign
+  // along the radius that noise does not make say the sample, beam or lens are not that (the
+  // diffusion models' own error is carried as their systematic instead).
+  if (model == FitModel::kTabulated) {
+    std::size_t offset = 0;
+    for (std::size_t b = 0; b < block_channels.size(); ++b) {
+      const auto [c, count] = block_channels[b];
+      const Observations* o = block_obs[b];
+      const std::size_t at = offset;
+      offset += std::size_t(count);
+      if (c < 0 || !o || !o->radial || o->linear || int(o->r.size()) != count) continue;
+      const RadialStructure s = radial_structure(o->r, residuals.data() + at, count);
+      ChannelFit& ch = fit.channels[c];
+      if (s.segments() == 0 || !(s.z > ch.structure_z)) continue;
+      ch.structure_z = s.z;
+      if (s.z > kMaxStructureZ && fit.converged) {
+        fit.converged = false;
+        fit.message = lack_of_fit_reason(s, "RGB"[c]);
+      }
+    }
   }
   fit.samples = samples[0] + samples[1] + samples[2];
   fit.aic = fit.chi2 + 2.0 * fit.parameters;

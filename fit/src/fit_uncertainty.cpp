@@ -143,12 +143,12 @@ void judge_adequacy(FitResult& result, const std::vector<ProfileData>& data,
       }
     }
     // The tightest of a few tolerance bands the model keeps beyond some radius within the first
-    // half of the data's reach (3% is the bar for "adequate").
+    // half of the data's reach (ModelAdequacy::kBar, 3%, is the bar for "adequate").
     ModelAdequacy a;
     a.model = m;
     a.max_deviation = max_deviation;
     a.beyond_mm = INFINITY;
-    for (double tolerance : {0.03, 0.05, 0.1, 0.2, 0.5}) {
+    for (double tolerance : {ModelAdequacy::kBar, 0.05, 0.1, 0.2, 0.5}) {
       double beyond = 0;
       for (const auto& channel : dev) {
         double last_bad = 0;
@@ -161,7 +161,7 @@ void judge_adequacy(FitResult& result, const std::vector<ProfileData>& data,
       a.beyond_mm = beyond;
       if (beyond <= 0.5 * reach) break;
     }
-    a.adequate = a.tolerance <= 0.03 && a.beyond_mm <= 0.5 * reach;
+    a.adequate = a.tolerance <= ModelAdequacy::kBar && a.beyond_mm <= 0.5 * reach;
     std::ostringstream note;
     note << to_string(m) << " with these coefficients: ";
     if (a.beyond_mm <= 0.5 * reach) {
@@ -170,7 +170,8 @@ void judge_adequacy(FitResult& result, const std::vector<ProfileData>& data,
            << " (worst " << number(100 * a.max_deviation, 2) << "% closer in)"
            << (a.adequate ? "; enough for scenes whose detail is coarser than " +
                                 number(std::max(a.beyond_mm, 1e-3)) + " mm"
-                          : "; not adequate at 3%");
+                          : "; not adequate (the bar is " + number(100 * ModelAdequacy::kBar) +
+                                "%)");
     } else {
       note << "more than " << 100 * a.tolerance << "% off the tabulated profile over much of "
            << "the data (worst " << number(100 * a.max_deviation, 2) << "%)";
@@ -178,19 +179,19 @@ void judge_adequacy(FitResult& result, const std::vector<ProfileData>& data,
     result.notes.push_back(note.str());
     result.adequacy.push_back(a);
   }
-  // The cheapest adequate model; when none is within 3%, the closest diffusion model (tightest
-  // band, then smallest radius), which a renderer without the table should use.
-  const ModelAdequacy* best = nullptr;
+  // The cheapest adequate model ("none" when none is); the renderers' fallback is that one, or the
+  // closest diffusion model (tightest band, then smallest radius) when none is adequate.
+  const ModelAdequacy* adequate = nullptr;
+  const ModelAdequacy* closest = nullptr;
   for (const ModelAdequacy& a : result.adequacy) {
-    if (a.adequate) {
-      best = &a;
-      break;
-    }
-    if (!best || a.tolerance < best->tolerance ||
-        (a.tolerance == best->tolerance && a.beyond_mm < best->beyond_mm))
-      best = &a;
+    if (a.adequate && !adequate) adequate = &a;
+    if (!closest || a.tolerance < closest->tolerance ||
+        (a.tolerance == closest->tolerance && a.beyond_mm < closest->beyond_mm))
+      closest = &a;
   }
-  result.adequate_model = best ? to_string(best->model) : "";
+  result.adequate_model = adequate ? to_string(adequate->model) : "none";
+  const ModelAdequacy* fallback = adequate ? adequate : closest;
+  result.fallback_model = fallback ? to_string(fallback->model) : "";
 }
 
 }  // namespace detail

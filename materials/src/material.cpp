@@ -31,10 +31,11 @@ constexpr std::string_view kFormatName = "lucent-material";
 constexpr std::array<std::string_view, 3> kChannelNames = {"R", "G", "B"};
 
 // Every top-level field the format knows, in the order they are written.
-constexpr std::array<std::string_view, 15> kKnownFields = {
-    "format",  "version", "name",           "ior",         "sigma_a",    "sigma_s_reduced",
-    "sigma_s", "g",       "model",          "adequate_model", "uncertainty", "provenance",
-    "derived", "diffuse_colour", "mfp_mm"};
+constexpr std::array<std::string_view, 16> kKnownFields = {
+    "format",         "version",        "name",        "ior",        "sigma_a",
+    "sigma_s_reduced", "sigma_s",       "g",           "model",      "adequate_model",
+    "fallback_model", "uncertainty",    "provenance",  "derived",    "diffuse_colour",
+    "mfp_mm"};
 
 // Agreement required between a given sigma_s' and sigma_s (1 - g): relative, with an absolute floor
 // for channels that (almost) do not scatter, where a relative test would demand exact zeros.
@@ -170,11 +171,16 @@ class MaterialReader {
                           truncated(m.model) + "\"");
     }
     if (const json* adequate = find("adequate_model")) {
-      if (!adequate->is_string() ||
-          (*adequate != "dipole" && *adequate != "ddipole" && *adequate != "tabulated"))
-        fail("adequate_model",
-             "expected \"dipole\", \"ddipole\" or \"tabulated\", found " + describe(*adequate));
+      if (!adequate->is_string() || (*adequate != "dipole" && *adequate != "ddipole" &&
+                                     *adequate != "tabulated" && *adequate != "none"))
+        fail("adequate_model", "expected \"dipole\", \"ddipole\", \"tabulated\" or \"none\", found " +
+                                   describe(*adequate));
       m.adequate_model = adequate->get<std::string>();
+    }
+    if (const json* fallback = find("fallback_model")) {
+      if (!fallback->is_string() || (*fallback != "dipole" && *fallback != "ddipole"))
+        fail("fallback_model", "expected \"dipole\" or \"ddipole\", found " + describe(*fallback));
+      m.fallback_model = fallback->get<std::string>();
     }
     m.uncertainty = read_object_or_null("uncertainty");
     m.provenance = read_object_or_null("provenance");
@@ -407,6 +413,7 @@ nlohmann::json material_to_json(const Material& material) {
   if (material.g) doc["g"] = rgb_json(*material.g);
   if (!material.model.empty()) doc["model"] = material.model;
   if (!material.adequate_model.empty()) doc["adequate_model"] = material.adequate_model;
+  if (!material.fallback_model.empty()) doc["fallback_model"] = material.fallback_model;
   if (!material.uncertainty.is_null()) doc["uncertainty"] = material.uncertainty;
   if (!material.provenance.is_null()) doc["provenance"] = material.provenance;
 

@@ -95,7 +95,12 @@ DiffusionModel preferred_model(const Material& material) {
     }
     return DiffusionModel::kTabulated;
   } catch (const Error&) {
-    if (fitted == "tabulated" && !material.adequate_model.empty())
+    // The fit's fallback (its adequate model, or the closest when none is adequate); files written
+    // before fallback_model existed name the closest one in adequate_model.
+    if (fitted == "tabulated" && !material.fallback_model.empty())
+      return parse_diffusion_model(material.fallback_model, "fallback_model", false);
+    if (fitted == "tabulated" && !material.adequate_model.empty() &&
+        material.adequate_model != "none")
       return parse_diffusion_model(material.adequate_model, "adequate_model", false);
     return DiffusionModel::kDirectionalDipole;  // eta or g outside the table
   }

@@ -80,9 +80,9 @@ struct Config {
 };
 
 // Realistic media (sigma_a 1e-4..2 /mm, sigma_s' 0.05..10 /mm, g 0..0.9, eta 1..1.6 and, one case
-// in ten, 0.8..1) and geometry at object scale (positions within 50 mm of the origin, r 1e-3..100
-// mm): planes, spheres seen from the lit side and from behind, slabs lit from the back, random
-// normals.
+// in ten, 0.5..1, where C_E is the quadrature's) and geometry at object scale (positions within 50
+// mm of the origin, r 1e-3..100 mm): planes, spheres seen from the lit side and from behind, slabs
+// lit from the back, random normals.
 class ConfigGenerator {
  public:
   explicit ConfigGenerator(std::uint64_t seed) : rng_(seed) {}
@@ -92,7 +92,7 @@ class ConfigGenerator {
     const double sigma_a = std::pow(10.0, uniform(-4.0, 0.3));
     const double sigma_s_reduced = std::pow(10.0, uniform(-1.3, 1.0));
     const double g = uniform(0.0, 0.9);
-    const double eta = (i % 10 == 0) ? uniform(0.8, 1.0) : uniform(1.0, 1.6);
+    const double eta = (i % 10 == 0) ? uniform(0.5, 1.0) : uniform(1.0, 1.6);
     c.medium = Medium<double>{sigma_a, sigma_s_reduced / (1.0 - g), g, eta};
     const double r = std::pow(10.0, uniform(-3.0, 2.0));
     c.x_i = Vec3d(uniform(-50, 50), uniform(-50, 50), uniform(-50, 50));

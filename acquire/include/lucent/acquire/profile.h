@@ -88,8 +88,10 @@ Profile read_profile(const std::filesystem::path& path);
 /// line.
 void write_profile(const std::filesystem::path& path, const Profile& profile);
 
-/// The radial bins as CSV: header r_mm,R_r,R_g,R_b,se_r,se_g,se_b,n_r,n_g,n_b, one row per bin,
-/// numbers with 17 significant digits (lossless for doubles).
+/// The radial bins as lucent's one radial CSV (what `lucent fit` reads): `#` lines of key=value
+/// tokens (quantity, R_unit, calibrated, incidence_deg, view_deg, pixel_mm, ior, and the white
+/// reference's calibration_relative_se), then r_mm,r_inner_mm,r_outer_mm,R_r,R_g,R_b,se_r,se_g,
+/// se_b,n_r,n_g,n_b, one row per bin, numbers with 17 significant digits (lossless for doubles).
 std::string profile_csv(const Profile& profile);
 
 /// How pixels are grouped into radial bins.

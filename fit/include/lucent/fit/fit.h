@@ -95,6 +95,10 @@ struct ChannelFit {
   /// to independent unit-variance noise (pixel-to-pixel correlated or unmodelled noise); 1
   /// otherwise.
   double design_effect = 1;
+  /// Structure left along the radius by the accurate model (radial data): how far, in standard
+  /// normal deviates, the runs of one sign in the residuals are beyond what noise makes (0 when not
+  /// judged: fewer than 24 bins, or a diffusion model, whose own error is its systematic).
+  double structure_z = 0;
   /// This channel's usable range: exclusion radius and the last bin above the noise floor, mm.
   double exclude_radius_mm = 0, range_end_mm = 0;
   /// The usable range in diffuse mean free paths 1 / sigma_tr (the fit's sigma_tr).
@@ -131,8 +135,12 @@ struct ModelFit {
 /// How well a cheaper model reproduces the chosen (accurate) material: its profile evaluated with
 /// the chosen coefficients against the chosen model's, over the data's radii.
 struct ModelAdequacy {
+  /// The bar for "adequate": within this relative deviation of the accurate profile beyond a radius
+  /// in the first half of the data's reach. The text, the file and the test use this one number.
+  static constexpr double kBar = 0.03;
   FitModel model = FitModel::kDipole;
-  double tolerance = 0.03;  ///< relative
+  /// The tightest of the bands 3, 5, 10, 20, 50% (relative) the model keeps beyond `beyond_mm`.
+  double tolerance = kBar;
   /// Beyond this radius (mm) the cheaper profile stays within `tolerance` in every channel up to
   /// the end of the data; infinity when it never does.
   double beyond_mm = 0;
@@ -148,7 +156,11 @@ struct FitResult {
   std::vector<std::string> notes;       ///< assumptions worth saying (assumed errors, ...)
   std::vector<std::string> warnings;    ///< results to distrust (short range, parameters at bounds)
   std::vector<ModelAdequacy> adequacy;  ///< cheaper models against the chosen one
-  std::string adequate_model;           ///< the cheapest adequate one ("" when none)
+  /// The cheapest adequate one; "none" when none is, "" when not judged (no accurate model).
+  std::string adequate_model;
+  /// What a renderer without the accurate model's table uses: the adequate model, else the closest
+  /// one (tightest band, then smallest radius). "" when not judged.
+  std::string fallback_model;
   double g = 0;                         ///< the g the tabulated model assumed
   /// Per channel {sigma_a, sigma_s'} of the tabulated fit at g = g_other (0.9, or 0 when the fit
   /// assumed g >= 0.45): how far the answer moves with the assumed g. Empty when not computed.

@@ -60,9 +60,11 @@ struct ProfileData {
 
 /// Reads a `lucent-profile` JSON (from lucent acquire) or lucent's radial CSV: optional leading
 /// `#` lines of `key=value` tokens (`ior=` or `eta=` the relative index, `quantity=exitance|
-/// radiance`, `R_unit=..._per_unit_incident_power`, `incidence_deg=`; what `lucent profile` and
-/// `lucent simulate --exitance-csv` write), the header `r_mm` and value columns `R` or
-/// `R_r,R_g,R_b`, optional `se` / `se_r,se_g,se_b` and `r_inner_mm,r_outer_mm`. CSV values are per
+/// radiance`, `R_unit=..._per_unit_incident_power`, `incidence_deg=`, `view_deg=`, `pixel_mm=`,
+/// `calibrated=true|false`, `calibration_relative_se=r,g,b`; what `lucent acquire`, `lucent
+/// profile` and `lucent simulate --exitance-csv` write), the header `r_mm` and value columns `R` or
+/// `R_r,R_g,R_b`, optional `se` / `se_r,se_g,se_b`, `r_inner_mm,r_outer_mm` (other columns, such as
+/// acquire's pixel counts `n_r,n_g,n_b`, are ignored). CSV values are per
 /// mm^2 per unit power entering unless the comments say otherwise; without se columns a 5%
 /// relative error is assumed (a note says so); rows whose standard error is 0 (no Monte Carlo
 /// photon arrived) are skipped and counted. Throws lucent::Error with one line naming the file,

@@ -28,9 +28,12 @@ struct Material {
   /// The model it was fitted with ("dipole", "ddipole", "tabulated"), or "".
   std::string model;
   /// For a tabulated fit: the cheapest diffusion model within 3% of the tabulated profile beyond a
-  /// radius the fit reports, or when none is, the closest one (provenance.fit.adequacy says how
-  /// close, and beyond which radius); what a renderer without the table uses. "" when not judged.
+  /// radius the fit reports (provenance.fit.adequacy says beyond which), "none" when none is, ""
+  /// when not judged.
   std::string adequate_model;
+  /// What a renderer without the table uses: the adequate model, or when none is, the closest one.
+  /// "" when not judged.
+  std::string fallback_model;
   nlohmann::json uncertainty;  ///< standard deviations and correlations; null when not fitted
   nlohmann::json provenance;   ///< source table or capture, fit statistics, tool version
 

@@ -1,0 +1,74 @@
+// Lack of fit along the radius (lack_of_fit.h).
+#include "lack_of_fit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace lucent::fit::detail {
+
+RadialStructure radial_structure(const std::vector<double>& r, const double* e, int n) {
+  RadialStructure s;
+  s.bins = n;
+  if (n < 24) return s;
+  std::vector<double> d;
+  d.reserve(std::size_t(n - 1));
+  for (int i = 0; i + 1 < n; ++i) d.push_back(std::abs(e[i + 1] - e[i]));
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  s.scale = std::max(1.4826 * d[d.size() / 2] / std::sqrt(2.0), 1e-12);
+  // Segments of 8 bins or more, at most 8 of them: long enough for a run of one sign to stand out
+  // of the noise, few enough that each is a distinct part of the profile.
+  const int k = std::clamp(n / 8, 3, 8);
+  for (int j = 0; j < k; ++j) {
+    const int a = j * n / k, b = (j + 1) * n / k;
+    double sum = 0;
+    for (int i = a; i < b; ++i) sum += e[i];
+    const double count = b - a;
+    s.q += sum * sum / (count * s.scale * s.scale);
+    s.mean.push_back(sum / count / s.scale);
+    s.r_mm.push_back(std::sqrt(r[std::size_t(a)] * r[std::size_t(b - 1)]));
+  }
+  // Wilson-Hilferty: (q / k)^(1/3) is nearly normal with mean 1 - 2 / (9k), variance 2 / (9k).
+  const double v = 2.0 / (9.0 * k);
+  s.z = (std::cbrt(s.q / k) - (1 - v)) / std::sqrt(v);
+  return s;
+}
+
+std::string lack_of_fit_reason(const RadialStructure& s, char channel) {
+  std::ostringstream why;
+  why.precision(2);
+  why << "the model leaves structure in channel " << channel << "'s residuals (runs of one sign "
+      << "along the radius, " << std::fixed << s.z << std::defaultfloat
+      << " SD beyond noise; a good fit stays below " << kMaxStructureZ << ")";
+  const int k = s.segments();
+  if (k == 0) return why.str();
+  // Where the largest run sits, and which way it goes (positive: the model above the data).
+  int worst = 0;
+  for (int j = 1; j < k; ++j)
+    if (std::abs(s.mean[j]) > std::abs(s.mean[worst])) worst = j;
+  const double last = s.mean[k - 1], first = s.mean[0];
+  if (worst == k - 1 || (worst >= k / 2 && last * s.mean[worst] > 0)) {
+    if (last > 0) {
+      // The data fall below the model from some radius on: the earliest segment of the run.
+      int from = k - 1;
+      while (from > 0 && s.mean[from - 1] > 0) --from;
+      why << ": the far tail falls faster than a semi-infinite sample allows. Is the sample "
+          << "thinner than about " << std::max(0.1, s.r_mm[from]) << " mm? Give --thickness-mm";
+    } else {
+      why << ": the far tail falls slower than the sample's transport allows: veiling glare or "
+             "stray light in the lens (a white reference through the same lens measures it), or "
+             "a dark level left in the data";
+    }
+  } else if (worst == 0 || worst < k / 2) {
+    why << (first > 0 ? ": the profile near the beam is flatter than a pencil beam's: a beam "
+                        "footprint or lens blur wider than assumed (give a white reference "
+                        "through the same lens, or --beam-sigma-mm)"
+                      : ": the profile near the beam is sharper than the model's: another eta "
+                        "(--ior) or g (--g), or light scattered once at the entry point");
+  } else {
+    why << ": another eta (--ior) or g (--g), or a sample that is not a homogeneous slab";
+  }
+  return why.str();
+}
+
+}  // namespace lucent::fit::detail
