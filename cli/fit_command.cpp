@@ -37,6 +37,8 @@ struct FitArguments {
   bool row_ior = false;      // a batch row gave ior
   std::uint64_t oblique_photons = 1'000'000;
   std::uint64_t table_photons = 1'000'000;
+  std::uint64_t slab_photons = 200'000;
+  double thickness_mm = 0;  // 0: not given
   bool fit_ior = false, relative = false, json = false, allow_unconverged = false;
   bool plot_log_r = false;  // --plot-log-r
 };
@@ -87,6 +89,7 @@ fit::FitOptions to_options(const FitArguments& a) {
   }
   // Given or not is what counts (the validators have checked the values): no value falls back.
   if (a.exclude_option && a.exclude_option->count() > 0) o.exclude_radius_mm = a.exclude_radius_mm;
+  if (a.thickness_mm > 0) o.thickness_mm = a.thickness_mm;
   if (a.row_ior || (a.ior_option && a.ior_option->count() > 0)) {
     if (!(a.ior > 0 && a.ior <= 4)) throw Error("--ior: expected a relative index in (0, 4]");
     o.ior = a.ior;
@@ -123,6 +126,7 @@ materials::Material run(const FitArguments& a) {
   if (const materials::TransportTable* radial =
           radial_table_for(data, options, a.table_photons, a.json || a.quiet || a.no_progress))
     options.table = radial;
+  options.slab = slab_nodes_for(data, options, a.slab_photons, a.json || a.quiet || a.no_progress);
   const std::optional<materials::TransportTable> oblique =
       oblique_table_for(data, options, a.oblique_table, a.oblique_photons, a.json);
   if (oblique) options.oblique_table = &*oblique;
@@ -305,6 +309,15 @@ void register_fit_command(CLI::App& app) {
   cmd->add_option("--oblique-photons", args->oblique_photons,
                   "photons of an oblique table built for this fit (about 50 s per million on "
                   "2 cores)")
+      ->check(CLI::Range(std::uint64_t(10'000), std::uint64_t(1'000'000'000)))
+      ->capture_default_str();
+  cmd->add_option("--thickness-mm", args->thickness_mm,
+                  "the sample is a slab this thick, mm, for every input (default: what each "
+                  "input says, thickness_mm and side, else semi-infinite); its tables are built "
+                  "on first use and kept in ~/.cache/lucent")
+      ->check(number_in(1e-3, 1e4, "mm"));
+  cmd->add_option("--slab-photons", args->slab_photons,
+                  "photons per slab table built for --thickness-mm (9 thickness nodes per side)")
       ->check(CLI::Range(std::uint64_t(10'000), std::uint64_t(1'000'000'000)))
       ->capture_default_str();
   cmd->add_option("--table-photons", args->table_photons,

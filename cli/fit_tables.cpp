@@ -172,4 +172,69 @@ const materials::TransportTable* radial_table_for(const std::vector<fit::Profile
   return t;
 }
 
+const std::vector<double>& slab_thickness_nodes() {
+  static const std::vector<double> nodes = {0.25, 0.5, 1, 2, 4, 8, 16, 32, 64};
+  return nodes;
+}
+
+std::shared_ptr<const materials::SlabNodes> slab_nodes_for(const std::vector<fit::ProfileData>& data,
+                                                          const fit::FitOptions& options,
+                                                          std::uint64_t photons, bool quiet) {
+  bool slab = false, far = false;
+  for (const fit::ProfileData& d : data) {
+    slab = slab || options.thickness_mm || d.thickness_mm;
+    far = far || d.transmitted;
+  }
+  if (!slab || options.fit_ior || options.model == fit::FitModel::kDipole ||
+      options.model == fit::FitModel::kDirectionalDipole)
+    return nullptr;
+  const std::optional<double> eta = options.ior ? options.ior : data.front().eta;
+  if (!eta || *eta < 1.0 || *eta > 2.5) return nullptr;  // the fit says why
+  const double g = options.g;
+  auto nodes = std::make_shared<materials::SlabNodes>();
+  std::ostringstream source;
+  source.precision(12);
+  source << "slab tables at eta " << *eta << ", g " << g << ", " << photons << " photons each";
+  nodes->source = source.str();
+  // Kept for the process (a batch's rows of one (eta, g) share them).
+  static std::map<std::string, std::shared_ptr<const materials::TabulatedProfile>> kept;
+  for (const bool transmitted : {false, true}) {
+    if (transmitted && !far) break;
+    for (const double t : slab_thickness_nodes()) {
+      std::ostringstream name;
+      name.precision(12);
+      name << "slab1-eta" << *eta << "-g" << g << "-t" << t << "-"
+           << (transmitted ? "transmitted" : "reflected") << "-n" << photons << ".lut";
+      std::shared_ptr<const materials::TabulatedProfile>& profile = kept[name.str()];
+      if (!profile) {
+        acquire::TabulateOptions o;
+        o.eta = {*eta};
+        o.g = {g};
+        o.photons = photons;
+        o.white_photons = std::clamp(std::uint64_t(double(photons) * 1.5 * (1 - g)),
+                                     std::uint64_t(o.groups) * 64, photons);
+        o.thickness_s = t;
+        o.transmitted = transmitted;
+        const auto has = [&](const materials::TransportTable& table) {
+          return !table.partial && table.slab() && table.slab_thickness_s == t &&
+                 table.transmitted == transmitted && table.slices.size() == 1 &&
+                 std::abs(table.slices[0].eta - *eta) < 1e-12 &&
+                 std::abs(table.slices[0].g - g) < 1e-12;
+        };
+        std::ostringstream what;
+        what << "slab table for eta " << *eta << ", g " << g << ", d sigma_s' " << t << ", "
+             << (transmitted ? "far" : "lit") << " side (" << photons << " photons";
+        const materials::TransportTable table =
+            cached_or_built(name.str(), o, has, what.str(), "slab", quiet);
+        profile = std::make_shared<const materials::TabulatedProfile>(
+            materials::TabulatedProfile::slab_node(table, g));
+      }
+      (transmitted ? nodes->transmitted : nodes->reflected).push_back(*profile);
+      (transmitted ? nodes->log_thickness_s_transmitted : nodes->log_thickness_s)
+          .push_back(std::log(t));
+    }
+  }
+  return nodes;
+}
+
 }  // namespace lucent::cli

@@ -4,11 +4,13 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "lucent/fit/fit.h"
+#include "lucent/materials/tabulated.h"
 #include "lucent/materials/transport_table.h"
 
 namespace lucent::cli {
@@ -37,5 +39,16 @@ const materials::TransportTable* radial_table_for(const std::vector<fit::Profile
 /// alpha' = 2e-4 (near-black media of high g, where the shipped table's last node, alpha' = 0.004,
 /// still scatters a sixth of the light at g = 0.98).
 materials::TransportTableGrid radial_fit_grid();
+
+/// The thickness nodes of a slab's tables, d sigma_s': 0.25 to 64 in factors of 2.
+const std::vector<double>& slab_thickness_nodes();
+
+/// The slab's tables of these data (any input with a thickness, from it or --thickness-mm), null
+/// when none is a slab or the model is not tabulated: at the data's eta and the fit's g, one
+/// table per thickness node and side the data need (lit side always: the fit starts there), from
+/// the cache or built now with `photons` photons each (progress on stderr unless quiet) and kept.
+std::shared_ptr<const materials::SlabNodes> slab_nodes_for(const std::vector<fit::ProfileData>& data,
+                                                          const fit::FitOptions& options,
+                                                          std::uint64_t photons, bool quiet);
 
 }  // namespace lucent::cli

@@ -24,6 +24,7 @@ struct SimulateArguments {
   std::string bracket_format = "png";
   std::string source = "montecarlo";
   std::string exitance_csv;
+  std::string side = "reflected";
   bool no_white = false;
   bool no_dark = false;
   bool no_noise = false;
@@ -146,6 +147,12 @@ void run(SimulateArguments& args) {
     o.source = acquire::RadianceSource::kDirectionalDipole;
   else
     throw Error("--source: expected montecarlo, dipole or ddipole, got '" + args.source + "'");
+  if (args.side != "reflected" && args.side != "transmitted")
+    throw Error("--side: expected reflected (the lit side) or transmitted (the far side), got '" +
+                args.side + "'");
+  o.transport.far_side = args.side == "transmitted";
+  if (o.transport.far_side && !std::isfinite(o.transport.thickness_mm))
+    throw Error("--side transmitted: the far side needs --thickness-mm");
   o.camera.noise = !args.no_noise;
   o.white_reference = !args.no_white;
   o.dark_frame = !args.no_dark;
@@ -221,6 +228,10 @@ void register_simulate_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--thickness-mm", o.transport.thickness_mm,
                   "slab thickness in mm (default: semi-infinite)");
+  cmd->add_option("--side", args->side,
+                  "which side the camera sees: reflected (the lit side) or transmitted (a slab's "
+                  "far side, the camera below; needs --thickness-mm)")
+      ->capture_default_str();
   cmd->add_option("--incidence-deg", o.transport.incidence_deg,
                   "beam angle from the normal, degrees [0, 90)")
       ->capture_default_str();

@@ -326,6 +326,8 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
   profile.incidence_azimuth_deg = capture.incidence_azimuth_deg;
   profile.view_deg = capture.view_deg;
   profile.ior = capture.ior;
+  profile.thickness_mm = capture.thickness_mm;
+  profile.transmitted = capture.transmitted;
   profile.beam_point_px = bp;
   profile.beam_point_source = summary.beam_point_source;
   profile.beam_power = summary.beam_power;

@@ -155,7 +155,7 @@ Capture capture_from_json(const nlohmann::json& doc, const std::string& source,
   in.only_known(
       doc, "",
       {"format", "version", "images", "hdr", "pixel_pitch_mm", "incidence", "view_deg", "ior",
-       "beam_point_px", "response", "dark", "white_reference", "beam_power", "provenance"});
+       "thickness_mm", "side", "beam_point_px", "response", "dark", "white_reference", "beam_power", "provenance"});
   if (!doc.contains("format")) in.fail("format", "missing (expected \"lucent-capture\")");
   if (doc["format"] != "lucent-capture") {
     in.fail("format", "expected \"lucent-capture\", found " + doc["format"].dump());
@@ -197,6 +197,18 @@ Capture capture_from_json(const nlohmann::json& doc, const std::string& source,
   if (doc.contains("ior")) {
     c.ior = in.number(doc["ior"], "ior");
     if (!(*c.ior >= 0.25 && *c.ior <= 4)) in.fail("ior", "expected a relative index in [0.25, 4]");
+  }
+  if (doc.contains("thickness_mm")) {
+    c.thickness_mm = in.number(doc["thickness_mm"], "thickness_mm");
+    if (!(*c.thickness_mm > 0 && *c.thickness_mm <= 1e4))
+      in.fail("thickness_mm", "expected a slab thickness in (0, 10000] mm");
+  }
+  if (doc.contains("side")) {
+    if (!doc["side"].is_string() || (doc["side"] != "reflected" && doc["side"] != "transmitted"))
+      in.fail("side", "expected \"reflected\" (the lit side) or \"transmitted\" (the far side)");
+    c.transmitted = doc["side"] == "transmitted";
+    if (c.transmitted && !c.thickness_mm)
+      in.fail("side", "\"transmitted\" needs the sample's thickness_mm");
   }
   if (doc.contains("beam_point_px")) {
     const json& p = doc["beam_point_px"];
@@ -252,6 +264,8 @@ json capture_to_json(const Capture& c) {
                       {"azimuth_deg", c.incidence_azimuth_deg}};
   doc["view_deg"] = c.view_deg;
   if (c.ior) doc["ior"] = *c.ior;
+  if (c.thickness_mm) doc["thickness_mm"] = *c.thickness_mm;
+  if (c.thickness_mm) doc["side"] = c.transmitted ? "transmitted" : "reflected";
   if (c.beam_point_px) doc["beam_point_px"] = {(*c.beam_point_px)[0], (*c.beam_point_px)[1]};
   doc["response"] = to_string(c.response);
   if (c.dark) doc["dark"] = c.dark->generic_string();

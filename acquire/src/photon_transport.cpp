@@ -92,6 +92,7 @@ struct Transport {
   double eta_out = 1;  // relative index going out, 1 / eta
   bool finite = false;
   double thickness_mm = 0;
+  bool far = false;  // the bins and the image record the bottom surface
   // Entry
   double specular = 0;
   double w0 = 1;
@@ -129,6 +130,7 @@ Transport make_transport(const PhotonTransportOptions& o, int channel,
   t.eta_out = 1.0 / m.eta;
   t.finite = std::isfinite(o.thickness_mm);
   t.thickness_mm = t.finite ? o.thickness_mm : 0.0;
+  t.far = o.far_side && t.finite;
 
   // Entry: Fresnel reflection of the beam, refraction by Snell's law.
   const double theta_i = radians(o.incidence_deg);
@@ -257,8 +259,11 @@ void trace_photons(const Transport& t, std::uint64_t photons, Xoshiro256StarStar
     double reflected = 0, transmitted = 0, absorbed = 0;
     std::uint64_t interactions = 0;
 
-    auto score_top = [&](double weight) {
-      reflected += weight;
+    // An escape through the top (reflected) or the bottom (transmitted); the bins record the side
+    // the camera sees, scattered light only in a slab (its unscattered beam is a point at r = 0).
+    auto score_exit = [&](double weight, bool top) {
+      (top ? reflected : transmitted) += weight;
+      if (top == t.far || (kFinite && interactions == 0)) return;
       const double r = std::sqrt(x * x + y * y);
       if (r < t.max_radius_mm) {
         const auto b = static_cast<std::size_t>(std::upper_bound(edges.begin(), edges.end(), r) -
@@ -308,11 +313,7 @@ void trace_photons(const Transport& t, std::uint64_t photons, Xoshiro256StarStar
         if constexpr (kSplit) {
           const double escaped = w * (1 - R);
           if (escaped > 0) {
-            if (top) {
-              score_top(escaped);
-            } else {
-              transmitted += escaped;
-            }
+            score_exit(escaped, top);
             w -= escaped;
           }
           uz = -uz;
@@ -322,11 +323,7 @@ void trace_photons(const Transport& t, std::uint64_t photons, Xoshiro256StarStar
           }
         } else {
           if (R < 1 && !(rng.uniform() < R)) {
-            if (top) {
-              score_top(w);
-            } else {
-              transmitted += w;
-            }
+            score_exit(w, top);
             w = 0;
             alive = false;
             break;
@@ -343,7 +340,9 @@ void trace_photons(const Transport& t, std::uint64_t photons, Xoshiro256StarStar
 
       if constexpr (kImage) {
         if (t.nee) {
-          const double s_exit = -z * t.inv_cos_t;
+          // To the surface the camera sees, along the refracted view direction (mirrored in z
+          // for the far side: the camera below looks up).
+          const double s_exit = (t.far ? z + t.thickness_mm : -z) * t.inv_cos_t;
           const double fi = (x + s_exit * t.wt_x) * t.inv_pixel_mm + t.half_size;
           const double fj = (y + s_exit * t.wt_y) * t.inv_pixel_mm + t.half_size;
           const double tau = t.sigma_t * s_exit;
@@ -352,7 +351,7 @@ void trace_photons(const Transport& t, std::uint64_t photons, Xoshiro256StarStar
             if constexpr (kIsotropic) {
               phase = 1.0 / (4 * kPi);
             } else {
-              phase = t.hg.pdf(ux * t.wt_x + uy * t.wt_y + uz * t.wt_z);
+              phase = t.hg.pdf(ux * t.wt_x + uy * t.wt_y + (t.far ? -uz : uz) * t.wt_z);
             }
             const double v = w * t.nee_factor * phase * std::exp(-tau);
             if (v > 0) {
@@ -516,6 +515,8 @@ void validate_photon_transport_options(const PhotonTransportOptions& o) {
   if (o.threads > 1024) bad_option("threads", "at most 1024 (0: all cores)", o.threads);
   if (!(o.thickness_mm > 0))
     bad_option("thickness_mm", "> 0 (infinity: semi-infinite)", o.thickness_mm);
+  if (o.far_side && !std::isfinite(o.thickness_mm))
+    throw Error("side: the far side (transmitted) needs a finite thickness_mm");
   if (!(o.incidence_deg >= 0 && o.incidence_deg < 90)) {
     bad_option("incidence_deg", "in [0, 90)", o.incidence_deg);
   }
@@ -761,7 +762,8 @@ std::string exitance_csv(const PhotonTransportResult& result) {
   s << "# sigma_s_per_mm=" << rgb_medium(&materials::Medium<double>::sigma_s) << '\n';
   s << "# g=" << rgb_medium(&materials::Medium<double>::g) << '\n';
   s << "# eta=" << rgb_medium(&materials::Medium<double>::eta) << '\n';
-  s << "# thickness_mm=" << format_number(o.thickness_mm) << '\n';
+  s << "# thickness_mm=" << format_number(o.thickness_mm)
+    << " side=" << (o.far_side ? "transmitted" : "reflected") << '\n';
   s << "# incidence_deg=" << format_number(o.incidence_deg)
     << " azimuth_deg=" << format_number(o.azimuth_deg) << '\n';
   s << "# max_radius_mm=" << format_number(o.max_radius_mm) << '\n';

@@ -66,6 +66,8 @@ ordered_json profile_to_ordered_json(const Profile& p) {
                       {"azimuth_deg", p.incidence_azimuth_deg}};
   doc["view_deg"] = p.view_deg;
   if (p.ior) doc["ior"] = *p.ior;
+  if (p.thickness_mm) doc["thickness_mm"] = *p.thickness_mm;
+  if (p.thickness_mm) doc["side"] = p.transmitted ? "transmitted" : "reflected";
   doc["beam_point_px"] = {p.beam_point_px[0], p.beam_point_px[1]};
   doc["beam_point_source"] = p.beam_point_source;
   doc["beam_power"] = p.beam_power ? ordered_json(*p.beam_power) : ordered_json(nullptr);
@@ -193,8 +195,9 @@ Profile profile_from_json(const json& doc, const std::string& source) {
   if (!doc.is_object()) throw Error(source + ": expected a JSON object (a lucent-profile file)");
   in.only_known(doc, "",
                 {"format", "version", "calibrated", "units", "capture", "pixel_pitch_mm",
-                 "incidence", "view_deg", "ior", "beam_point_px", "beam_point_source", "beam_power",
-                 "radial", "samples_2d", "masked", "provenance"});
+                 "incidence", "view_deg", "ior", "thickness_mm", "side", "beam_point_px",
+                 "beam_point_source", "beam_power", "radial", "samples_2d", "masked",
+                 "provenance"});
   if (!doc.contains("format") || doc["format"] != "lucent-profile") {
     in.fail("format", "expected \"lucent-profile\", found " +
                           (doc.contains("format") ? doc["format"].dump() : std::string("nothing")));
@@ -231,6 +234,18 @@ Profile profile_from_json(const json& doc, const std::string& source) {
   if (doc.contains("ior")) {
     p.ior = in.number(doc["ior"], "ior");
     if (!(*p.ior >= 0.25 && *p.ior <= 4)) in.fail("ior", "expected a relative index in [0.25, 4]");
+  }
+  if (doc.contains("thickness_mm")) {
+    p.thickness_mm = in.number(doc["thickness_mm"], "thickness_mm");
+    if (!(*p.thickness_mm > 0 && *p.thickness_mm <= 1e4))
+      in.fail("thickness_mm", "expected a slab thickness in (0, 10000] mm");
+  }
+  if (doc.contains("side")) {
+    if (!doc["side"].is_string() || (doc["side"] != "reflected" && doc["side"] != "transmitted"))
+      in.fail("side", "expected \"reflected\" (the lit side) or \"transmitted\" (the far side)");
+    p.transmitted = doc["side"] == "transmitted";
+    if (p.transmitted && !p.thickness_mm)
+      in.fail("side", "\"transmitted\" needs the sample's thickness_mm");
   }
   const auto point = in.numbers(in.get(doc, "beam_point_px", "beam_point_px"), "beam_point_px", 2);
   p.beam_point_px = {point[0], point[1]};
@@ -338,6 +353,9 @@ std::string profile_csv(const Profile& profile) {
          " view_deg=" + format_number(profile.view_deg) +
          " pixel_mm=" + format_number(profile.pixel_pitch_mm);
   if (profile.ior) out += " ior=" + format_number(*profile.ior);
+  if (profile.thickness_mm)
+    out += " thickness_mm=" + format_number(*profile.thickness_mm) +
+           " side=" + (profile.transmitted ? "transmitted" : "reflected");
   out += "\n";
   if (profile.beam_power && profile.provenance.contains("white_reference")) {
     const json& white = profile.provenance["white_reference"];

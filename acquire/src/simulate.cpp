@@ -231,6 +231,8 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
     capture.incidence_azimuth_deg = transport.azimuth_deg;
     capture.view_deg = transport.view_deg;
     capture.ior = options.material.ior;
+    if (std::isfinite(transport.thickness_mm)) capture.thickness_mm = transport.thickness_mm;
+    capture.transmitted = transport.far_side;
     // At oblique incidence the light emerges ahead of the entry point, so the brightest region no
     // longer marks it; a real rig marks it (the specular glint, a fiducial). The simulator knows
     // it: the corner between the four middle pixels.

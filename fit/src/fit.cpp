@@ -44,7 +44,25 @@ std::string g_text(double g) {  // 0.917, not std::to_string's 0.917000 cut to 0
 
 }  // namespace
 
-FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& options) {
+FitResult fit_profiles(const std::vector<ProfileData>& input, const FitOptions& options) {
+  // A slab: the thickness the options give every input, or each input's own.
+  std::vector<ProfileData> data = input;
+  bool slab = false;
+  if (options.thickness_mm && !(*options.thickness_mm > 0 && *options.thickness_mm <= 1e4))
+    throw Error("--thickness-mm: expected a slab thickness in (0, 10000] mm");
+  for (ProfileData& d : data) {
+    if (options.thickness_mm) d.thickness_mm = options.thickness_mm;
+    if (d.transmitted && !d.thickness_mm)
+      throw Error(d.source + ": the far side (side=transmitted) needs the sample's thickness: "
+                             "give --thickness-mm");
+    slab = slab || d.thickness_mm.has_value();
+  }
+  if (slab && (options.model == FitModel::kDipole || options.model == FitModel::kDirectionalDipole))
+    throw Error("--model " + std::string(options.model == FitModel::kDipole ? "dipole" : "ddipole") +
+                ": the diffusion models are of a semi-infinite sample; a slab (--thickness-mm) is "
+                "fitted with the tabulated model");
+  if (slab && options.fit_ior)
+    throw Error("--fit-ior: a slab (--thickness-mm) is fitted at a given index (--ior)");
   // Ceres logs (through glog) a warning with every residual of a rejected trial step that went
   // non-finite; the solver handles those steps itself, and a user should see our one-line errors
   // only.
@@ -171,7 +189,27 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
       oblique_source = slice->to_string();
     }
   }
+  if (slab && table_problem.empty()) {
+    // The slab's nodes at this (eta, g), the lit side's ending with this table's semi-infinite
+    // profile at 4 times the thickest slab.
+    for (const ProfileData& d : data)
+      if (d.samples_2d.has_value() && d.incidence_polar_deg > 0)
+        throw Error(d.source + ": a slab (--thickness-mm) is fitted from radial profiles at normal "
+                               "incidence");
+    if (!options.slab || options.slab->reflected.empty())
+      throw Error("--thickness-mm: the slab's transport tables are missing (lucent fit builds "
+                  "them; in the library pass FitOptions::slab)");
+    for (const auto* list : {&options.slab->reflected, &options.slab->transmitted})
+      for (const materials::TabulatedProfile& node : *list)
+        if (std::abs(node.eta_nodes().front() - eta0) > 1e-9 || std::abs(node.g() - options.g) > 1e-9)
+          throw Error("--thickness-mm: the slab's tables are for another eta or g than the fit's");
+    auto nodes = std::make_shared<materials::SlabNodes>(*options.slab);
+    nodes->reflected.push_back(*fixed);
+    nodes->log_thickness_s.push_back(nodes->log_thickness_s.back() + std::log(4.0));
+    fixed = std::make_shared<const materials::TabulatedProfile>(fixed->with_slab(nodes));
+  }
   const bool tab_ok = full && table_problem.empty();
+  if (slab && !tab_ok) throw Error("--thickness-mm: " + table_problem);
   if (options.model == FitModel::kTabulated && !tab_ok)
     throw Error("--model tabulated: " + table_problem);
   const materials::TabulatedProfile* tab = options.fit_ior ? full.get() : fixed.get();
@@ -289,8 +327,10 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
     report("fitting the tabulated model", kShareTabulated);
     ModelFit accurate = fit_model(FitModel::kTabulated, dipole ? started_from(*dipole) : start);
     result.candidates.push_back(accurate);
-    if (dipole && options.model != FitModel::kTabulated) result.candidates.push_back(*dipole);
-    if (options.model == FitModel::kAuto) {
+    // A slab: the (semi-infinite) dipoles only start the accurate fit.
+    if (dipole && options.model != FitModel::kTabulated && !slab)
+      result.candidates.push_back(*dipole);
+    if (options.model == FitModel::kAuto && !slab) {
       try {
         report("fitting the directional dipole", kShareDirectional);
         result.candidates.push_back(fit_model(FitModel::kDirectionalDipole, start));
@@ -333,6 +373,14 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
           "transport table (g = " +
           g_text(options.g) +
           ") to transport at normal incidence; the cheaper models are judged against it";
+    } else if (slab) {
+      std::ostringstream why;
+      why << "tabulated: exact to radiative transfer for a slab of "
+          << (options.thickness_mm ? *options.thickness_mm : *data.front().thickness_mm)
+          << " mm under a normal pencil beam (lucent's Monte Carlo slab tables at g = "
+          << g_text(options.g) << "); the diffusion models, of a semi-infinite sample, are not "
+          << "judged";
+      result.reason = why.str();
     } else if (options.model == FitModel::kAuto) {
       result.reason =
           "tabulated: exact to radiative transfer for a radial profile at normal incidence "
@@ -433,7 +481,11 @@ FitResult fit_profiles(const std::vector<ProfileData>& data, const FitOptions& o
     }
   }
   detail::finish_uncertainty(result, options, channels);
-  if (tab_ok && options.systematics && result.chosen.model == FitModel::kTabulated) {
+  if (slab && options.systematics)
+    result.notes.push_back(
+        "a slab: no cheaper model is judged (the dipoles are of a semi-infinite sample), and the "
+        "g systematic is not computed (the slab's tables hold one g)");
+  if (tab_ok && options.systematics && result.chosen.model == FitModel::kTabulated && !slab) {
     report("the adequacy of the dipoles and the g systematic", kShareAdequacy);
     detail::judge_adequacy(result, data, channels);
     // g: radial data cannot tell it from sigma_s; say how far the answer moves at the other end.

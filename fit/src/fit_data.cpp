@@ -137,6 +137,22 @@ ProfileData parse_profile_csv(std::string_view text, const std::string& source) 
       d.calibration_relative_se[c] = v;
     }
   }
+  // thickness_mm= (inf: semi-infinite, as the simulator writes it) and side=reflected|transmitted.
+  if (auto it = meta.find("thickness_mm"); it != meta.end() && it->second != "inf") {
+    const auto thickness = meta_number("thickness_mm");
+    if (!(*thickness > 0 && *thickness <= 1e4))
+      throw Error(source + ": comment field thickness_mm=" + it->second +
+                  ": expected a slab thickness in (0, 10000] mm, or inf");
+    d.thickness_mm = thickness;
+  }
+  if (auto it = meta.find("side"); it != meta.end()) {
+    if (it->second != "reflected" && it->second != "transmitted")
+      throw Error(source + ": comment field side=" + it->second +
+                  ": expected reflected (the lit side) or transmitted (the far side)");
+    d.transmitted = it->second == "transmitted";
+    if (d.transmitted && !d.thickness_mm)
+      throw Error(source + ": comment field side=transmitted: the far side needs thickness_mm=");
+  }
   if (auto incidence = meta_number("incidence_deg")) {
     if (!(*incidence >= 0 && *incidence < 90))
       throw Error(source + ": comment field incidence_deg: expected [0, 90) degrees");
@@ -254,6 +270,8 @@ ProfileData profile_data_from_json(const nlohmann::json& doc, const std::string&
     }
   }
   d.eta = p.ior;
+  d.thickness_mm = p.thickness_mm;
+  d.transmitted = p.transmitted;
   d.incidence_polar_deg = p.incidence_polar_deg;
   d.incidence_azimuth_deg = p.incidence_azimuth_deg;
   d.view_deg = p.view_deg;

@@ -22,6 +22,8 @@ double predicted_radial(const ModelFit& fit, const ProfileData& data, int c, dou
   g.cos_view = std::cos(data.view_deg * std::numbers::pi / 180);
   g.exitance = data.exitance;
   g.per_incident_power = data.per_incident_power;
+  if (data.thickness_mm) g.thickness_mm = *data.thickness_mm;
+  g.transmitted = data.transmitted;
   // What the fit compares with: a pixel footprint at r when the bins are pixel averages.
   const detail::GaussLegendre gl = detail::gauss_legendre(2);
   const double p = data.radial.pixel_mm;

@@ -31,6 +31,8 @@ inline CaptureGeometry geometry_of(const ProfileData& d) {
   g.w_i = {-std::sin(theta) * std::cos(phi), -std::sin(theta) * std::sin(phi), std::cos(theta)};
   g.exitance = d.exitance;
   g.per_incident_power = d.per_incident_power;
+  if (d.thickness_mm) g.thickness_mm = *d.thickness_mm;
+  g.transmitted = d.transmitted;
   return g;
 }
 
@@ -87,7 +89,7 @@ struct ProfileResiduals {
       if (oblique && table->oblique())
         ob.emplace(*table->oblique(), medium);
       else
-        tab.emplace(*table, medium);
+        tab.emplace(*table, medium, obs->geometry.thickness_mm, obs->geometry.transmitted);
     }
     if (tab && oblique) dd.emplace(medium);
     const materials::TableQuantity q = detail::table_quantity(obs->geometry);

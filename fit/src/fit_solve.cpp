@@ -173,7 +173,9 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
                                    std::atan2(std::abs(-o.x[i] * ty + o.y[i] * tx),
                                               o.x[i] * tx + o.y[i] * ty),
                                    alpha)
-                 : table->relative_se(q, r * st, alpha, eta0);
+                 : table->relative_se(q, r * st, alpha, eta0,
+                                      o.geometry.thickness_mm * start[c].sigma_s_reduced,
+                                      o.geometry.transmitted);
           const double d2 = o.data_rel_se[i] * o.data_rel_se[i];
           o.inv_rel_se[i] = std::isfinite(t) ? 1.0 / std::sqrt(d2 + t * t) : 1e-3 / std::sqrt(d2);
           if (o.linear) {  // the table's relative error of a value about max(value, se)
@@ -486,8 +488,17 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
       const std::size_t at = offset;
       offset += std::size_t(count);
       if (c < 0 || !o || !o->radial || o->linear || int(o->r.size()) != count) continue;
-      const RadialStructure s = radial_structure(o->r, residuals.data() + at, count);
+      // The table's share of each residual's error (its weight holds data and table in
+      // quadrature): sqrt(1 - (data's relative error x weight)^2).
+      std::vector<double> model_share(std::size_t(count), 0.0);
+      for (int i = 0; i < count; ++i) {
+        const double a = o->data_rel_se[std::size_t(i)] * o->inv_rel_se[std::size_t(i)];
+        model_share[std::size_t(i)] = std::sqrt(std::max(0.0, 1 - a * a));
+      }
+      const RadialStructure s =
+          radial_structure(o->r, residuals.data() + at, count, model_share.data());
       ChannelFit& ch = fit.channels[c];
+      if (std::getenv("LOFDBG") && s.segments()) { std::fprintf(stderr, "LOF %c z=%.1f scale=%.2f:", "RGB"[c], s.z, s.scale); for (int j = 0; j < s.segments(); ++j) std::fprintf(stderr, " %.1f@%.2g", s.mean[j], s.r_mm[j]); std::fprintf(stderr, "\n"); }
       if (s.segments() == 0 || !(s.z > ch.structure_z)) continue;
       ch.structure_z = s.z;
       if (s.z > kMaxStructureZ && fit.converged) {

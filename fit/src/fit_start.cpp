@@ -9,6 +9,7 @@
 
 #include "lucent/materials/albedo.h"
 #include "lucent/materials/dipole.h"
+#include "fit_residuals.h"
 #include "model_prediction.h"
 
 namespace lucent::fit::detail {
@@ -65,15 +66,6 @@ double plane_total(const RadialBins& bins, int c, double sigma_tr) {
   return total;
 }
 
-CaptureGeometry geometry_of(const ProfileData& d) {
-  CaptureGeometry g;
-  const double theta = d.incidence_polar_deg * std::numbers::pi / 180;
-  g.cos_incidence = std::cos(theta);
-  g.cos_view = std::cos(d.view_deg * std::numbers::pi / 180);
-  g.exitance = d.exitance;
-  g.per_incident_power = d.per_incident_power;
-  return g;
-}
 
 }  // namespace
 

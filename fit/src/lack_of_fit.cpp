@@ -7,7 +7,8 @@
 
 namespace lucent::fit::detail {
 
-RadialStructure radial_structure(const std::vector<double>& r, const double* e, int n) {
+RadialStructure radial_structure(const std::vector<double>& r, const double* e, int n,
+                                 const double* model_share) {
   RadialStructure s;
   s.bins = n;
   if (n < 24) return s;
@@ -16,16 +17,31 @@ RadialStructure radial_structure(const std::vector<double>& r, const double* e, 
   for (int i = 0; i + 1 < n; ++i) d.push_back(std::abs(e[i + 1] - e[i]));
   std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
   s.scale = std::max(1.4826 * d[d.size() / 2] / std::sqrt(2.0), 1e-12);
+  // The data's share of each residual's error, a_i = sqrt(1 - b_i^2): white noise, the part the
+  // first differences measure, so the data's own scale is scale / rms(a).
+  double mean_a2 = 0;
+  for (int i = 0; i < n; ++i) {
+    const double b = model_share ? std::clamp(model_share[i], 0.0, 1.0) : 0.0;
+    mean_a2 += 1 - b * b;
+  }
+  mean_a2 = std::max(mean_a2 / n, 1e-6);
+  const double data_scale2 = s.scale * s.scale / mean_a2;
   // Segments of 8 bins or more, at most 8 of them: long enough for a run of one sign to stand out
   // of the noise, few enough that each is a distinct part of the profile.
   const int k = std::clamp(n / 8, 3, 8);
   for (int j = 0; j < k; ++j) {
     const int a = j * n / k, b = (j + 1) * n / k;
-    double sum = 0;
-    for (int i = a; i < b; ++i) sum += e[i];
+    double sum = 0, a2 = 0, model = 0;
+    for (int i = a; i < b; ++i) {
+      sum += e[i];
+      const double m = model_share ? std::clamp(model_share[i], 0.0, 1.0) : 0.0;
+      a2 += 1 - m * m;
+      model += m;  // the model's error, in units of the residuals (the table's SEs taken as they are)
+    }
     const double count = b - a;
-    s.q += sum * sum / (count * s.scale * s.scale);
-    s.mean.push_back(sum / count / s.scale);
+    const double variance = data_scale2 * a2 + model * model;
+    s.q += sum * sum / variance;
+    s.mean.push_back(sum / std::sqrt(variance));
     s.r_mm.push_back(std::sqrt(r[std::size_t(a)] * r[std::size_t(b - 1)]));
   }
   // Wilson-Hilferty: (q / k)^(1/3) is nearly normal with mean 1 - 2 / (9k), variance 2 / (9k).
@@ -46,11 +62,10 @@ std::string lack_of_fit_reason(const RadialStructure& s, char channel) {
   int worst = 0;
   for (int j = 1; j < k; ++j)
     if (std::abs(s.mean[j]) > std::abs(s.mean[worst])) worst = j;
-  const double last = s.mean[k - 1], first = s.mean[0];
-  if (worst == k - 1 || (worst >= k / 2 && last * s.mean[worst] > 0)) {
-    if (last > 0) {
-      // The data fall below the model from some radius on: the earliest segment of the run.
-      int from = k - 1;
+  if (worst >= k / 2) {
+    if (s.mean[worst] > 0) {
+      // The data fall below the model in the far half: from the start of that run on.
+      int from = worst;
       while (from > 0 && s.mean[from - 1] > 0) --from;
       why << ": the far tail falls faster than a semi-infinite sample allows. Is the sample "
           << "thinner than about " << std::max(0.1, s.r_mm[from]) << " mm? Give --thickness-mm";
@@ -59,14 +74,13 @@ std::string lack_of_fit_reason(const RadialStructure& s, char channel) {
              "stray light in the lens (a white reference through the same lens measures it), or "
              "a dark level left in the data";
     }
-  } else if (worst == 0 || worst < k / 2) {
-    why << (first > 0 ? ": the profile near the beam is flatter than a pencil beam's: a beam "
-                        "footprint or lens blur wider than assumed (give a white reference "
-                        "through the same lens, or --beam-sigma-mm)"
-                      : ": the profile near the beam is sharper than the model's: another eta "
-                        "(--ior) or g (--g), or light scattered once at the entry point");
   } else {
-    why << ": another eta (--ior) or g (--g), or a sample that is not a homogeneous slab";
+    why << (s.mean[worst] > 0
+                ? ": the profile near the beam is flatter than a pencil beam's: a beam footprint "
+                  "or lens blur wider than assumed (give a white reference through the same "
+                  "lens, or --beam-sigma-mm)"
+                : ": the profile near the beam is sharper than the model's: another eta (--ior) "
+                  "or g (--g), or a sample that is not a homogeneous slab");
   }
   return why.str();
 }

@@ -22,13 +22,20 @@ struct RadialStructure {
   /// q as a standard normal deviate (Wilson-Hilferty): how far beyond noise the structure is.
   double z = 0;
   std::vector<double> r_mm;  ///< each segment's middle radius, mm
-  std::vector<double> mean;  ///< each segment's mean residual, in units of `scale`
+  /// each segment's sum of residuals over the standard deviation noise gives that sum (data and
+  /// model): a standard normal deviate where the model holds
+  std::vector<double> mean;
   int segments() const { return int(mean.size()); }
 };
 
 /// Structure of n residuals e (model above data is positive) at radii r (ascending); empty (no
 /// segments) below 24 bins, where a few segments cannot be told from the fitted parameters.
-RadialStructure radial_structure(const std::vector<double>& r, const double* e, int n);
+/// model_share (optional): per residual, the part of its standard error that is the model's own
+/// (the transport table's Monte Carlo noise, in units of the residual's total error). That noise
+/// is smooth along the radius (one table entry spans many bins), so it is counted as fully
+/// correlated within a segment, and what noise alone makes grows by it.
+RadialStructure radial_structure(const std::vector<double>& r, const double* e, int n,
+                                 const double* model_share = nullptr);
 
 /// The bar for z: measured on good fits (semi-infinite Monte Carlo profiles and simulated camera
 /// captures, the model exact), so that a good fit is refused less than 1 time in 100 (README, "Real

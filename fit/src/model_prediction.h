@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "lucent/fit/fit.h"
@@ -45,6 +46,10 @@ struct CaptureGeometry {
   bool exitance = false;
   /// Per unit power incident on the sample (a camera), not per unit power entering it.
   bool per_incident_power = true;
+  /// A slab of this thickness (mm; infinity: semi-infinite) seen from its lit side or, with
+  /// `transmitted`, its far side: the tabulated model's SlabNodes.
+  double thickness_mm = std::numeric_limits<double>::infinity();
+  bool transmitted = false;
 };
 
 /// What multiplies the model's value (dipole R_d, ddipole pi S_d, the table's exitance or normal
@@ -202,7 +207,7 @@ T model_value(FitModel model, const materials::TabulatedProfile* table,
       if (!radial && g.cos_incidence < 0.9999 && table->oblique())
         return oblique_pixel(materials::ObliqueModel<T>(*table->oblique(), medium), q, g, x, y,
                              pixel, gl);
-      const materials::TabulatedModel<T> tab(*table, medium);
+      const materials::TabulatedModel<T> tab(*table, medium, g.thickness_mm, g.transmitted);
       if (!radial && g.cos_incidence < 0.9999)
         return corrected_ddipole_pixel(tab, materials::DirectionalDipole<T>(medium), q, g, x, y,
                                        pixel, gl);

@@ -2,6 +2,7 @@
 #include "lucent/materials/tabulated.h"
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -52,8 +53,21 @@ void to_point_values(std::vector<double>& f, const std::vector<double>& x,
 
 using detail::to_point_values;
 
+TabulatedProfile TabulatedProfile::slab_node(const TransportTable& table, double g) {
+  TransportTable semi;  // the same slices read as a semi-infinite table's (only the flag differs)
+  semi.grid = table.grid;
+  semi.partial = table.partial;
+  semi.slices = table.slices;
+  semi.source = table.source;
+  return TabulatedProfile(semi, g);
+}
+
 TabulatedProfile::TabulatedProfile(const TransportTable& table, double g) : g_(g) {
   if (table.partial) throw Error(table.source + ": a partial table (merge the shards first)");
+  if (table.slab())
+    throw Error(table.source + ": a slab's table (" + (table.transmitted ? "far" : "lit") +
+                " side): lucent fit builds and uses these for --thickness-mm; it is not a "
+                "semi-infinite --table");
   if (table.grid.phi_bins != 1)
     throw Error(table.source + ": an oblique table (2D, " + std::to_string(table.grid.phi_bins) +
                 " azimuths): give it as --oblique-table, not as the radial --table");
@@ -177,9 +191,23 @@ TabulatedProfile TabulatedProfile::with_oblique(std::shared_ptr<const ObliquePro
   return p;
 }
 
+TabulatedProfile TabulatedProfile::with_slab(std::shared_ptr<const SlabNodes> slab) const {
+  TabulatedProfile p = *this;
+  p.slab_ = std::move(slab);
+  return p;
+}
+
 TabulatedProfile TabulatedProfile::perturbed(std::uint64_t seed) const {
   TabulatedProfile p = *this;
   if (oblique_) p.oblique_ = std::make_shared<const ObliqueProfile>(oblique_->perturbed(seed + 7919));
+  if (slab_) {
+    // Each node its own realisation of its noise (the nodes are independent runs).
+    auto slab = std::make_shared<SlabNodes>(*slab_);
+    std::uint64_t k = 0;
+    for (auto* list : {&slab->reflected, &slab->transmitted})
+      for (TabulatedProfile& node : *list) node = node.perturbed(seed + 104729 * ++k);
+    p.slab_ = std::move(slab);
+  }
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal(0.0, 1.0);
   for (std::size_t s = 0; s < p.f_.size(); ++s) {
@@ -193,6 +221,21 @@ TabulatedProfile TabulatedProfile::perturbed(std::uint64_t seed) const {
     }
   }
   return p;
+}
+
+double TabulatedProfile::relative_se(TableQuantity q, double rho, double alpha_prime, double eta,
+                                     double thickness_s, bool transmitted) const {
+  if (!slab_ || !(thickness_s < std::numeric_limits<double>::infinity()))
+    return relative_se(q, rho, alpha_prime, eta);
+  const std::vector<double>& x =
+      transmitted ? slab_->log_thickness_s_transmitted : slab_->log_thickness_s;
+  const std::vector<TabulatedProfile>& nodes = transmitted ? slab_->transmitted : slab_->reflected;
+  if (nodes.empty()) return relative_se(q, rho, alpha_prime, eta);
+  const double t = std::log(thickness_s);
+  const auto hi = std::size_t(std::lower_bound(x.begin(), x.end(), t) - x.begin());
+  const std::size_t a = hi == 0 ? 0 : hi - 1, b = std::min(hi, x.size() - 1);
+  return std::max(nodes[a].relative_se(q, rho, alpha_prime, eta),
+                  nodes[b].relative_se(q, rho, alpha_prime, eta));
 }
 
 double TabulatedProfile::relative_se(TableQuantity q, double rho, double alpha_prime,

@@ -87,7 +87,8 @@ json slice_json(double eta, double g, std::uint64_t photons, double incidence_de
 // bins (diffusion's far field, e^(-sigma_tr rho) / rho^(3/2) between the point-source and
 // dipole forms), with the slope held <= 0.
 void extrapolate_tail(const TransportTableGrid& grid, std::vector<double>& v,
-                      std::vector<double>& rel_se, std::vector<bool>& extrapolated) {
+                      std::vector<double>& rel_se, std::vector<bool>& extrapolated,
+                      bool allow_empty) {
   const int J = grid.rho_bins();
   // The last bin measured to kMeasuredRelativeSe; a row too faint for that (the near-black nodes
   // at high g, with few photons) takes the threshold up until some bins qualify.
@@ -98,6 +99,12 @@ void extrapolate_tail(const TransportTableGrid& grid, std::vector<double>& v,
       if (v[j] > 0 && rel_se[j] < threshold) last = j;
   }
   threshold /= 2;
+  if (last < 0 && allow_empty) {
+    // A slab's far side at an albedo and thickness that let nothing through (thick and dark):
+    // a floor far below any capture's noise, every entry unsupported.
+    for (int j = 0; j < J; ++j) v[j] = 1e-30, extrapolated[j] = true;
+    return;
+  }
   if (last < 0) throw Error("transport table: a row has no measured entry (too few photons)");
   double sw = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
   int used = 0;
@@ -225,7 +232,7 @@ void finish_transport_table(TransportTable& table, const std::vector<TransportTa
         std::vector<double> v(mean.begin() + long(k * J), mean.begin() + long((k + 1) * J));
         std::vector<double> r(rel.begin() + long(k * J), rel.begin() + long((k + 1) * J));
         std::vector<bool> extrapolated(std::size_t(J), false);
-        extrapolate_tail(table.grid, v, r, extrapolated);
+        extrapolate_tail(table.grid, v, r, extrapolated, table.slab());
         for (int j = 0; j < J; ++j) {
           const std::size_t e = k * std::size_t(J) + std::size_t(j);
           slice.value[std::size_t(q)][e] = float(std::max(v[std::size_t(j)], 1e-37));
@@ -309,6 +316,11 @@ void write_transport_table(const TransportTable& t, const std::filesystem::path&
   if (t.partial) h["shard"] = t.shard, h["partial_groups"] = groups;
   if (t.single_scattering_line_excluded)
     h["radiance_single_scattering"] = "excluded: the beam's line y = 0, added in closed form";
+  if (t.slab())
+    h["slab"] = {{"thickness_s", t.slab_thickness_s},
+                 {"side", t.transmitted ? "transmitted" : "reflected"},
+                 {"units", "d sigma_s' (a node of alpha' a is a slab of d sigma_t' = thickness_s / "
+                           "a); side: which surface is tallied; the unscattered beam is left out"}};
   write_file_atomically(path, h.dump() + "\n" + payload, /*binary=*/true);
 }
 
@@ -385,6 +397,16 @@ TransportTable read_transport_table_unchecked(const std::filesystem::path& path)
     t.generator = field("generator").get<std::string>();
     t.partial = field("kind").get<std::string>() == "partial";
     t.single_scattering_line_excluded = h.contains("radiance_single_scattering");
+    if (h.contains("slab")) {
+      const json& slab = h.at("slab");
+      t.slab_thickness_s = slab.at("thickness_s").get<double>();
+      const std::string side = slab.at("side").get<std::string>();
+      if (!(t.slab_thickness_s > 0 && t.slab_thickness_s < 1e9) ||
+          (side != "reflected" && side != "transmitted"))
+        throw Error(src + ": slab: expected thickness_s in (0, 1e9) and side reflected or "
+                          "transmitted");
+      t.transmitted = side == "transmitted";
+    }
     for (const json& s : field("slices"))
       t.slice_axes.push_back({s.at("eta").get<double>(), s.at("g").get<double>(),
                               double(whole_number<std::uint64_t>(s.at("photons"), src, "photons")),

@@ -48,6 +48,11 @@ struct Capture {
   double incidence_azimuth_deg = 0.0;  ///< beam direction in the image plane from +x, degrees
   double view_deg = 0.0;               ///< camera angle from the normal, degrees, [0, 90)
   std::optional<double> ior;           ///< the sample's relative index, when known (fit uses it)
+  /// A slab's thickness, mm, when the sample is one (absent: thick enough to count as
+  /// semi-infinite), and which side the camera sees: the lit one (reflectance) or the far one
+  /// (transmittance). lucent fit models the slab from these.
+  std::optional<double> thickness_mm;
+  bool transmitted = false;
   std::optional<std::array<double, 2>> beam_point_px;  ///< given entry point (x, y) in pixels
   Response response = Response::kLinear;
   std::optional<std::filesystem::path> dark;  ///< dark frame, same camera settings

@@ -39,6 +39,11 @@ struct PhotonTransportOptions {
   std::array<materials::Medium<double>, 3> media{};
   /// Slab thickness, mm; infinity for a semi-infinite sample.
   double thickness_mm = std::numeric_limits<double>::infinity();
+  /// A slab seen from its far side: the radial bins and the camera image record the light leaving
+  /// the bottom surface (transmittance), the camera below looking up. The unscattered beam is in
+  /// the totals (transmittance) but not in the bins or the image (a point at the centre). Needs a
+  /// finite thickness.
+  bool far_side = false;
   /// Polar angle of the incident beam from the surface normal, degrees, in [0, 90).
   double incidence_deg = 0;
   /// Azimuth of the beam's direction of travel in the surface plane, degrees from +x: at 0 the beam

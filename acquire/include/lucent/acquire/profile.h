@@ -59,6 +59,8 @@ struct Profile {
   double incidence_azimuth_deg = 0;
   double view_deg = 0;
   std::optional<double> ior;  ///< the sample's relative index when the capture states it
+  std::optional<double> thickness_mm;  ///< a slab's thickness, mm, when the capture states it
+  bool transmitted = false;            ///< the far side of the slab (transmittance)
   /// Entry point in pixels; pixel (i, j) covers [i, i + 1) x [j, j + 1), its centre is (i + 0.5, j
   /// + 0.5).
   std::array<double, 2> beam_point_px{};

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <vector>
 
 #include "lucent/materials/transport_table.h"
@@ -30,6 +31,15 @@ struct TabulateOptions {
   /// smallest nonzero 1 - alpha', kept less than e^-40 of its weight; only the alpha' = 1 node
   /// loses anything, and only far out).
   double max_path = 2e5;
+  /// A slab instead of a semi-infinite sample: its thickness in units of 1 / sigma_s' (d sigma_s',
+  /// the white run's own length unit, so that one white run still serves every albedo; the direct
+  /// runs of albedo a walk d sigma_t' = thickness_s / a). Infinity: semi-infinite. Normal incidence
+  /// only. The same outside medium below as above.
+  double thickness_s = std::numeric_limits<double>::infinity();
+  /// With a finite thickness_s: tally the light leaving the far side (transmittance: exitance and
+  /// the radiance along the outward normal below), not the lit side. The unscattered beam (a point
+  /// at rho = 0) is in neither the bins nor the totals.
+  bool transmitted = false;
   int shard_index = 0;  ///< this shard, in [0, shard_count)
   int shard_count = 1;  ///< > 1: write a partial table of every shard_count-th (slice, group)
 };

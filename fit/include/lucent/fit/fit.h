@@ -16,6 +16,7 @@
 namespace lucent::materials {
 class TabulatedProfile;
 struct TransportTable;
+struct SlabNodes;
 }  // namespace lucent::materials
 
 namespace lucent::fit {
@@ -41,6 +42,13 @@ struct FitOptions {
   double g = 0;
   /// The transport table; null: the shipped one (materials::default_transport_table()).
   const materials::TransportTable* table = nullptr;
+  /// The sample is a slab this thick (mm), for every input (over what the inputs say); absent:
+  /// what each input says (thickness_mm, side), else semi-infinite.
+  std::optional<double> thickness_mm;
+  /// A slab's tables at the data's (eta, g) (lucent fit builds them: cli/fit_tables.h); needed
+  /// when any input is a slab. The lit side's nodes without the semi-infinite one (the fit adds
+  /// its own table's).
+  std::shared_ptr<const materials::SlabNodes> slab;
   /// An oblique table (lucent tabulate --incidence-deg) holding the slice at the data's eta, g
   /// and incidence: 2D oblique data are then fitted with it, exact to transport. Null, or no
   /// such slice: the directional dipole corrected by the radial table (a note says so).

@@ -52,6 +52,10 @@ struct ProfileData {
   /// Values per unit power incident on the sample (a camera; lucent simulate's exitance CSV)
   /// rather than per unit power entering it (lucent profile's CSV, and CSV by default).
   bool per_incident_power = true;
+  /// A slab's thickness, mm (absent: a semi-infinite sample), and the side the data are of: the
+  /// lit one (reflectance) or the far one (transmittance).
+  std::optional<double> thickness_mm;
+  bool transmitted = false;
   RadialBins radial;
   std::optional<Samples2d> samples_2d;
   std::array<bool, 3> channels{true, true, true};  ///< which channels carry data

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <optional>
@@ -175,6 +176,19 @@ void to_point_values(std::vector<double>& f, const std::vector<double>& x,
 }  // namespace detail
 
 class ObliqueProfile;
+class TabulatedProfile;
+
+/// A slab's profiles at one (eta, g), one per thickness node (d sigma_s', ascending; lucent fit
+/// --thickness-mm builds and caches them): the lit side's and the far side's. The lit side's list
+/// ends with the semi-infinite profile, placed at 4 times the thickest slab (beyond it the lit side
+/// is the semi-infinite sample's within the table's reach).
+struct SlabNodes {
+  std::vector<double> log_thickness_s;             ///< ln(d sigma_s') of reflected's nodes
+  std::vector<TabulatedProfile> reflected;          ///< one eta each
+  std::vector<double> log_thickness_s_transmitted;  ///< ln(d sigma_s') of transmitted's nodes
+  std::vector<TabulatedProfile> transmitted;
+  std::string source;  ///< for messages: where the nodes came from
+};
 
 /// A transport table at one g, ready to evaluate: log(value / alpha') at the point centres of the
 /// radius bins (the annulus averages of the file turned into point values by a second-order
@@ -184,6 +198,9 @@ class TabulatedProfile {
   /// The slices of `table` at anisotropy g: a g node, or C1 interpolation between g nodes (every g
   /// node must have the same eta slices). Throws lucent::Error when g is outside the table.
   TabulatedProfile(const TransportTable& table, double g);
+  /// A slab table's slices (TransportTable::slab()), for SlabNodes; the constructor above refuses
+  /// them.
+  static TabulatedProfile slab_node(const TransportTable& table, double g);
   /// The same profile with eta fixed (one slice: faster when eta is not fitted).
   TabulatedProfile at_eta(double eta) const;
   /// A copy with every measured entry's log value moved by a normal draw of its relative standard
@@ -194,6 +211,10 @@ class TabulatedProfile {
   /// in place of the corrected directional dipole (and perturbs it with the rest).
   TabulatedProfile with_oblique(std::shared_ptr<const ObliqueProfile> oblique) const;
   const ObliqueProfile* oblique() const { return oblique_.get(); }
+  /// A copy carrying a slab's profiles at its eta and g: TabulatedModel evaluates a slab of a given
+  /// thickness and side from them (and perturbed() perturbs them with the rest).
+  TabulatedProfile with_slab(std::shared_ptr<const SlabNodes> slab) const;
+  const SlabNodes* slab() const { return slab_.get(); }
 
   double g() const { return g_; }
   double eta_min() const { return eta_.front(); }
@@ -275,6 +296,11 @@ class TabulatedProfile {
   /// The table's relative standard error near (rho, alpha', eta) (the largest of the entries the
   /// interpolation leans on most); infinity in an extrapolated tail.
   double relative_se(TableQuantity q, double rho, double alpha_prime, double eta) const;
+  /// The same for a slab of d sigma_s' = thickness_s seen from one side (SlabNodes): the larger of
+  /// the two thickness nodes around it (this profile's own where it has no slab nodes, or
+  /// thickness_s is infinite).
+  double relative_se(TableQuantity q, double rho, double alpha_prime, double eta,
+                     double thickness_s, bool transmitted) const;
   /// The relative standard error of the table's total diffuse reflectance at the nearest nodes.
   double total_relative_se(double alpha_prime, double eta) const;
 
@@ -291,6 +317,7 @@ class TabulatedProfile {
   std::vector<std::vector<double>> log_total_;  // [slice][k]: log(total / alpha')
   std::vector<std::vector<double>> total_rel_se_;  // [slice][k]
   std::shared_ptr<const ObliqueProfile> oblique_;
+  std::shared_ptr<const SlabNodes> slab_;
 };
 
 /// A prepared profile of `table` at g (and, when given, at a fixed eta), made once per (table, g,
@@ -305,14 +332,40 @@ template <typename T>
 class TabulatedModel {
  public:
   /// The profile's g is the medium's anisotropy (the medium's own g is not used: sigma_s' is).
-  TabulatedModel(const TabulatedProfile& profile, const Medium<T>& m)
+  /// thickness_mm finite: a slab of that thickness (the profile must carry SlabNodes), its lit side
+  /// or, with `transmitted`, its far side; interpolated C1 in ln(d sigma_s') between the nodes.
+  TabulatedModel(const TabulatedProfile& profile, const Medium<T>& m,
+                 double thickness_mm = std::numeric_limits<double>::infinity(),
+                 bool transmitted = false)
       : profile_(&profile), eta_(m.eta) {
     using std::sqrt;
     sigma_t_reduced_ = m.sigma_a + m.sigma_s * (T(1) - m.g);
     alpha_prime_ = sigma_t_reduced_ > T(0) ? m.sigma_s * (T(1) - m.g) / sigma_t_reduced_ : T(0);
     if (alpha_prime_ > T(0)) {
       const T one_minus = T(1) - alpha_prime_;
-      profile.rows_at(one_minus > T(0) ? sqrt(one_minus) : T(0), eta_, rows_);
+      const T u = one_minus > T(0) ? sqrt(one_minus) : T(0);
+      const SlabNodes* slab = profile.slab();
+      if (slab && thickness_mm < std::numeric_limits<double>::infinity()) {
+        using std::log;
+        const std::vector<double>& x =
+            transmitted ? slab->log_thickness_s_transmitted : slab->log_thickness_s;
+        const std::vector<TabulatedProfile>& nodes = transmitted ? slab->transmitted : slab->reflected;
+        // d sigma_s' = d alpha' sigma_t'; clamped to the nodes' range.
+        const NodeWeights<T> w =
+            hermite_weights(x, log(T(thickness_mm) * alpha_prime_ * sigma_t_reduced_), false);
+        std::array<std::vector<T>, kTableQuantities> node_rows;
+        for (int k = 0; k < w.count; ++k) {
+          nodes[std::size_t(w.first + k)].rows_at(u, eta_, node_rows);
+          for (int q = 0; q < kTableQuantities; ++q) {
+            std::vector<T>& row = rows_[std::size_t(q)];
+            if (row.empty()) row.assign(node_rows[std::size_t(q)].size(), T(0));
+            for (std::size_t j = 0; j < row.size(); ++j)
+              row[j] += w.w[std::size_t(k)] * node_rows[std::size_t(q)][j];
+          }
+        }
+      } else {
+        profile.rows_at(u, eta_, rows_);
+      }
       scale_ = sigma_t_reduced_ * sigma_t_reduced_ * alpha_prime_;
       // Beyond the table: the standard dipole's fall-off in optical units (sigma_t' = 1).
       const DiffusionCoefficients<T> c =

@@ -18,6 +18,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -110,6 +111,12 @@ struct TransportTable {
   /// An oblique table's radiance leaves out the beam's single scattering (a line on the surface,
   /// added in closed form by ObliqueModel). Tables that include it are refused as oblique ones.
   bool single_scattering_line_excluded = false;
+  /// A slab's table (lucent fit --thickness-mm builds them): its thickness as d sigma_s' (the
+  /// table's u and rho axes are per alpha', so the slab of every entry is d sigma_t' =
+  /// slab_thickness_s / alpha'), and which side it tallies. Infinity: a semi-infinite sample.
+  double slab_thickness_s = std::numeric_limits<double>::infinity();
+  bool transmitted = false;  ///< the far side (transmittance) rather than the lit side
+  bool slab() const { return slab_thickness_s < std::numeric_limits<double>::infinity(); }
 };
 
 /// Reads a table (finished or partial). Throws lucent::Error naming the file and the field.
