@@ -36,8 +36,8 @@ struct SimulateArguments {
   acquire::SimulateOptions options;
 };
 
-// The default field: wide enough for a fit to see 3.5 diffusion lengths (1 / sigma_tr) of the
-// slowest-falling channel beyond its exclusion radius, pixels a quarter of the shortest transport
+// The default field: wide enough for a fit to see 3.5 diffusion lengths (1 / sigma_tr), or 5
+// transport mean free paths, of the slowest-falling channel beyond its exclusion radius, pixels a quarter of the shortest transport
 // mean free path (0.02..0.1 mm, coarser when the field would pass 1024 pixels). The fit warns below
 // 3 diffusion lengths; the old fixed 12.8 mm field gave marble 0.7 and a -8% sigma_a.
 struct Field {
@@ -57,9 +57,10 @@ Field default_field(const materials::Material& m, int size, double pixel_mm, boo
     if (!(ss > 0)) continue;  // does not scatter: no profile to see
     const double st = sa + ss, sigma_tr = std::sqrt(3 * sa * st);
     shortest_mfp = std::min(shortest_mfp, 1 / st);
-    // Beyond the fit's default exclusion (a tenth of a transport mean free path) and at least
-    // 20 transport mean free paths (near-black media: the profile lives within a few).
-    const double need = std::max(kDiffusionLengths / std::max(sigma_tr, 1e-300), 20 / st) + 0.1 / st;
+    // Beyond the fit's default exclusion (a tenth of a transport mean free path), and at least 5
+    // transport mean free paths (near black, where 3.5 diffusion lengths are 2 of them).
+    const double need =
+        std::max(kDiffusionLengths / std::max(sigma_tr, 1e-300), 5 / st) + 0.1 / st;
     if (need > half_width) half_width = need, slowest = c;
   }
   Field f{size, pixel_mm, ""};

@@ -41,6 +41,7 @@ double peak(const imaging::ImageRgb& image) {
 json transport_to_json(const PhotonTransportOptions& o) {
   return {
       {"thickness_mm", std::isfinite(o.thickness_mm) ? json(o.thickness_mm) : json("infinite")},
+      {"side", o.far_side ? "transmitted" : "reflected"},
       {"incidence_deg", o.incidence_deg},
       {"azimuth_deg", o.azimuth_deg},
       {"photons_per_channel", o.photons},

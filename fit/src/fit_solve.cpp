@@ -487,7 +487,8 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
       const Observations* o = block_obs[b];
       const std::size_t at = offset;
       offset += std::size_t(count);
-      if (c < 0 || !o || !o->radial || o->linear || int(o->r.size()) != count) continue;
+      // Radial bins (of an annulus, or of pixel averages: then o->radial is false, o->r kept).
+      if (c < 0 || !o || o->linear || int(o->r.size()) != count) continue;
       // The table's share of each residual's error (its weight holds data and table in
       // quadrature): sqrt(1 - (data's relative error x weight)^2).
       std::vector<double> model_share(std::size_t(count), 0.0);
@@ -498,7 +499,6 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
       const RadialStructure s =
           radial_structure(o->r, residuals.data() + at, count, model_share.data());
       ChannelFit& ch = fit.channels[c];
-      if (std::getenv("LOFDBG") && s.segments()) { std::fprintf(stderr, "LOF %c z=%.1f scale=%.2f:", "RGB"[c], s.z, s.scale); for (int j = 0; j < s.segments(); ++j) std::fprintf(stderr, " %.1f@%.2g", s.mean[j], s.r_mm[j]); std::fprintf(stderr, "\n"); }
       if (s.segments() == 0 || !(s.z > ch.structure_z)) continue;
       ch.structure_z = s.z;
       if (s.z > kMaxStructureZ && fit.converged) {
