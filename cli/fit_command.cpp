@@ -39,6 +39,7 @@ struct FitArguments {
   std::uint64_t table_photons = 1'000'000;
   std::uint64_t slab_photons = 200'000;
   double thickness_mm = 0;  // 0: not given
+  double beam_sigma_mm = 0;  // 0: not given
   bool fit_ior = false, relative = false, json = false, allow_unconverged = false;
   bool plot_log_r = false;  // --plot-log-r
 };
@@ -90,6 +91,7 @@ fit::FitOptions to_options(const FitArguments& a) {
   // Given or not is what counts (the validators have checked the values): no value falls back.
   if (a.exclude_option && a.exclude_option->count() > 0) o.exclude_radius_mm = a.exclude_radius_mm;
   if (a.thickness_mm > 0) o.thickness_mm = a.thickness_mm;
+  o.beam_sigma_mm = a.beam_sigma_mm;
   if (a.row_ior || (a.ior_option && a.ior_option->count() > 0)) {
     if (!(a.ior > 0 && a.ior <= 4)) throw Error("--ior: expected a relative index in (0, 4]");
     o.ior = a.ior;
@@ -316,6 +318,11 @@ void register_fit_command(CLI::App& app) {
                   "input says, thickness_mm and side, else semi-infinite); its tables are built "
                   "on first use and kept in ~/.cache/lucent")
       ->check(number_in(1e-3, 1e4, "mm"));
+  cmd->add_option("--beam-sigma-mm", args->beam_sigma_mm,
+                  "the beam (with the lens) as a round Gaussian of this sigma, mm, for every "
+                  "input (default: each input's system response measured by its white reference, "
+                  "where wider than the pixels; else a pencil beam)")
+      ->check(number_in(1e-3, 100, "mm"));
   cmd->add_option("--slab-photons", args->slab_photons,
                   "photons per slab table built for --thickness-mm (9 thickness nodes per side)")
       ->check(CLI::Range(std::uint64_t(10'000), std::uint64_t(1'000'000'000)))

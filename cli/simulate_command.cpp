@@ -229,6 +229,24 @@ void register_simulate_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--thickness-mm", o.transport.thickness_mm,
                   "slab thickness in mm (default: semi-infinite)");
+  cmd->add_option("--beam-sigma-mm", o.transport.beam_sigma_mm,
+                  "a beam of finite width: Gaussian footprint of this sigma, mm (0: a pencil "
+                  "beam); the white reference is lit by the same beam")
+      ->check(number_in(0, 100, "mm"))
+      ->capture_default_str();
+  cmd->add_option("--lens-blur-mm", o.lens_blur_mm,
+                  "lens blur: Gaussian sigma on the sample, mm (sample and white reference)")
+      ->check(number_in(0, 100, "mm"))
+      ->capture_default_str();
+  cmd->add_option("--glare", o.glare,
+                  "veiling glare: the fraction of each pixel's light the lens spreads over the "
+                  "field (a clean lens has 0.01-0.05)")
+      ->check(number_in(0, 0.99, "a fraction"))
+      ->capture_default_str();
+  cmd->add_option("--glare-radius-mm", o.glare_radius_mm,
+                  "core radius a of the glare kernel a / (2 pi (r^2 + a^2)^1.5), mm")
+      ->check(number_in(1e-3, 1000, "mm"))
+      ->capture_default_str();
   cmd->add_option("--side", args->side,
                   "which side the camera sees: reflected (the lit side) or transmitted (a slab's "
                   "far side, the camera below; needs --thickness-mm)")

@@ -103,6 +103,60 @@ BeamPower white_reference_power(const HdrResult& white, double reflectance, doub
   return result;
 }
 
+// The system response the white reference records: its light, averaged over the channels, in rings
+// of half a pixel about its centroid, normalised to unit integral (per mm^2); and its rms radius.
+// Rings run to the nearest image edge. The border's level is not taken off (unlike for the beam
+// power): far from the spot it is the lens's veiling glare, which the response must keep (a dark
+// frame taken with the beam off carries the room's light).
+struct SystemResponse {
+  std::vector<double> r_mm, value;
+  double rms_mm = 0;
+};
+SystemResponse white_reference_response(const HdrResult& white, const BeamPower& power,
+                                        double pixel_mm) {
+  const int w = white.width(), h = white.height();
+  std::vector<double> v(std::size_t(w) * h, 0.0);
+  double total = 0, cx = 0, cy = 0, peak = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      double sum = 0;
+      for (int c = 0; c < 3; ++c)
+        if (white.mask_at(x, y, c) != PixelMask::kNonFinite)
+          sum += white.radiance.at(x, y, c) / power.power[c];
+      v[std::size_t(y) * w + x] = sum / 3;
+      peak = std::max(peak, sum / 3);
+    }
+  // The centroid of the spot (pixels above a tenth of the peak: the noise far out would pull it).
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const double s = v[std::size_t(y) * w + x];
+      if (s > 0.1 * peak) total += s, cx += s * (x + 0.5), cy += s * (y + 0.5);
+    }
+  SystemResponse r;
+  if (!(total > 0)) return r;
+  cx /= total, cy /= total;
+  const double reach = std::min({cx, cy, w - cx, h - cy});
+  const int rings = std::max(1, int(2 * reach));
+  std::vector<double> sum(std::size_t(rings), 0.0), count(std::size_t(rings), 0.0);
+  double all = 0, second = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const double d = std::hypot(x + 0.5 - cx, y + 0.5 - cy), s = v[std::size_t(y) * w + x];
+      all += s, second += s * d * d;
+      const int k = int(2 * d);
+      if (k < rings) sum[std::size_t(k)] += s, count[std::size_t(k)] += 1;
+    }
+  if (!(all > 0)) return r;
+  const double area = pixel_mm * pixel_mm;
+  for (int k = 0; k < rings; ++k) {
+    if (count[std::size_t(k)] == 0) continue;
+    r.r_mm.push_back((k + 0.5) * 0.5 * pixel_mm);
+    r.value.push_back(sum[std::size_t(k)] / count[std::size_t(k)] / (all * area));
+  }
+  r.rms_mm = std::sqrt(std::max(0.0, second / all)) * pixel_mm;
+  return r;
+}
+
 // The picture for a person: log tone mapping between the 1st and 99.9th percentile luminance, sRGB,
 // masked pixels magenta, the entry point as a cross and rings at every n-th bin edge. Small images
 // are enlarged (nearest neighbour) so that the marks stay legible.
@@ -261,6 +315,7 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
   // Calibration.
   std::array<double, 3> scale{kPi, kPi, kPi};
   json white_json = nullptr;
+  SystemResponse response;
   summary.beam_power_source = "none";
   if (capture.white_reference) {
     const WhiteReference& reference = *capture.white_reference;
@@ -279,6 +334,7 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
                                                   capture.pixel_pitch_mm, white.sources_text);
     summary.beam_power = power.power;
     summary.beam_power_source = "white reference";
+    response = white_reference_response(white, power, capture.pixel_pitch_mm);
     white_json = {
         {"reflectance", reference.reflectance},
         {"beam_power_standard_error", power.standard_error},
@@ -328,6 +384,9 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
   profile.ior = capture.ior;
   profile.thickness_mm = capture.thickness_mm;
   profile.transmitted = capture.transmitted;
+  profile.response_r_mm = response.r_mm;
+  profile.response_value = response.value;
+  profile.response_rms_mm = response.rms_mm;
   profile.beam_point_px = bp;
   profile.beam_point_source = summary.beam_point_source;
   profile.beam_power = summary.beam_power;

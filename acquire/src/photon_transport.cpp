@@ -93,6 +93,7 @@ struct Transport {
   bool finite = false;
   double thickness_mm = 0;
   bool far = false;  // the bins and the image record the bottom surface
+  double beam_sigma_mm = 0;
   // Entry
   double specular = 0;
   double w0 = 1;
@@ -131,6 +132,7 @@ Transport make_transport(const PhotonTransportOptions& o, int channel,
   t.finite = std::isfinite(o.thickness_mm);
   t.thickness_mm = t.finite ? o.thickness_mm : 0.0;
   t.far = o.far_side && t.finite;
+  t.beam_sigma_mm = o.beam_sigma_mm;
 
   // Entry: Fresnel reflection of the beam, refraction by Snell's law.
   const double theta_i = radians(o.incidence_deg);
@@ -254,6 +256,11 @@ void trace_photons(const Transport& t, std::uint64_t photons, Xoshiro256StarStar
 
   for (std::uint64_t n = 0; n < photons; ++n) {
     double x = 0, y = 0, z = 0;
+    if (t.beam_sigma_mm > 0) {  // the entry point within the beam's footprint (Box-Muller)
+      const double radius = t.beam_sigma_mm * std::sqrt(-2 * std::log(rng.uniform_open()));
+      const double angle = 2 * kPi * rng.uniform();
+      x = radius * std::cos(angle), y = radius * std::sin(angle);
+    }
     double ux = t.ux0, uy = t.uy0, uz = t.uz0;
     double w = t.w0;
     double reflected = 0, transmitted = 0, absorbed = 0;
@@ -515,6 +522,8 @@ void validate_photon_transport_options(const PhotonTransportOptions& o) {
   if (o.threads > 1024) bad_option("threads", "at most 1024 (0: all cores)", o.threads);
   if (!(o.thickness_mm > 0))
     bad_option("thickness_mm", "> 0 (infinity: semi-infinite)", o.thickness_mm);
+  if (!(o.beam_sigma_mm >= 0 && o.beam_sigma_mm <= 100))
+    bad_option("beam_sigma_mm", "in [0, 100] mm (0: a pencil beam)", o.beam_sigma_mm);
   if (o.far_side && !std::isfinite(o.thickness_mm))
     throw Error("side: the far side (transmitted) needs a finite thickness_mm");
   if (!(o.incidence_deg >= 0 && o.incidence_deg < 90)) {

@@ -68,6 +68,12 @@ ordered_json profile_to_ordered_json(const Profile& p) {
   if (p.ior) doc["ior"] = *p.ior;
   if (p.thickness_mm) doc["thickness_mm"] = *p.thickness_mm;
   if (p.thickness_mm) doc["side"] = p.transmitted ? "transmitted" : "reflected";
+  if (!p.response_r_mm.empty())
+    doc["system_response"] = {{"r_mm", p.response_r_mm},
+                              {"value", p.response_value},
+                              {"rms_radius_mm", p.response_rms_mm},
+                              {"units", "per mm^2, unit integral over the plane"},
+                              {"source", "white reference"}};
   doc["beam_point_px"] = {p.beam_point_px[0], p.beam_point_px[1]};
   doc["beam_point_source"] = p.beam_point_source;
   doc["beam_power"] = p.beam_power ? ordered_json(*p.beam_power) : ordered_json(nullptr);
@@ -195,7 +201,8 @@ Profile profile_from_json(const json& doc, const std::string& source) {
   if (!doc.is_object()) throw Error(source + ": expected a JSON object (a lucent-profile file)");
   in.only_known(doc, "",
                 {"format", "version", "calibrated", "units", "capture", "pixel_pitch_mm",
-                 "incidence", "view_deg", "ior", "thickness_mm", "side", "beam_point_px",
+                 "incidence", "view_deg", "ior", "thickness_mm", "side", "system_response",
+                 "beam_point_px",
                  "beam_point_source", "beam_power", "radial", "samples_2d", "masked",
                  "provenance"});
   if (!doc.contains("format") || doc["format"] != "lucent-profile") {
@@ -246,6 +253,24 @@ Profile profile_from_json(const json& doc, const std::string& source) {
     p.transmitted = doc["side"] == "transmitted";
     if (p.transmitted && !p.thickness_mm)
       in.fail("side", "\"transmitted\" needs the sample's thickness_mm");
+  }
+  if (doc.contains("system_response")) {
+    const json& s = doc["system_response"];
+    if (!s.is_object()) in.fail("system_response", "expected an object");
+    in.only_known(s, "system_response.", {"r_mm", "value", "rms_radius_mm", "units", "source"});
+    const json& r = in.get(s, "r_mm", "system_response.r_mm");
+    if (!r.is_array() || r.size() < 2 || r.size() > 100000)
+      in.fail("system_response.r_mm", "expected 2..100000 radii");
+    p.response_r_mm = in.numbers(r, "system_response.r_mm", r.size());
+    p.response_value =
+        in.numbers(in.get(s, "value", "system_response.value"), "system_response.value", r.size());
+    p.response_rms_mm =
+        in.number(in.get(s, "rms_radius_mm", "system_response.rms_radius_mm"),
+                  "system_response.rms_radius_mm");
+    for (std::size_t i = 0; i < p.response_r_mm.size(); ++i)
+      if (!(p.response_r_mm[i] >= 0) || (i > 0 && !(p.response_r_mm[i] > p.response_r_mm[i - 1])))
+        in.fail("system_response.r_mm", "expected radii >= 0 mm, rising");
+    if (!(p.response_rms_mm >= 0)) in.fail("system_response.rms_radius_mm", "expected >= 0 mm");
   }
   const auto point = in.numbers(in.get(doc, "beam_point_px", "beam_point_px"), "beam_point_px", 2);
   p.beam_point_px = {point[0], point[1]};
@@ -371,6 +396,17 @@ std::string profile_csv(const Profile& profile) {
       }
       out += "# calibration_relative_se=" + se + "\n";
     }
+  }
+  if (!profile.response_r_mm.empty()) {
+    // The white reference's system response (see Profile), as comma lists.
+    std::string r = "# system_response_rms_mm=" + format_number(profile.response_rms_mm) +
+                    "\n# system_response_r_mm=";
+    for (std::size_t i = 0; i < profile.response_r_mm.size(); ++i)
+      r += (i ? "," : "") + format_number(profile.response_r_mm[i]);
+    r += "\n# system_response=";
+    for (std::size_t i = 0; i < profile.response_value.size(); ++i)
+      r += (i ? "," : "") + format_number(profile.response_value[i]);
+    out += r + "\n";
   }
   out += "r_mm,r_inner_mm,r_outer_mm,R_r,R_g,R_b,se_r,se_g,se_b,n_r,n_g,n_b\n";
   const RadialProfile& r = profile.radial;

@@ -42,6 +42,7 @@ json transport_to_json(const PhotonTransportOptions& o) {
   return {
       {"thickness_mm", std::isfinite(o.thickness_mm) ? json(o.thickness_mm) : json("infinite")},
       {"side", o.far_side ? "transmitted" : "reflected"},
+      {"beam_sigma_mm", o.beam_sigma_mm},
       {"incidence_deg", o.incidence_deg},
       {"azimuth_deg", o.azimuth_deg},
       {"photons_per_channel", o.photons},
@@ -211,13 +212,17 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
   }
 
   if (!options.profile_only) {
-    const imaging::ImageRgb radiance =
+    const imaging::ImageRgb truth_radiance =
         monte_carlo ? to_image(result, false)
                     : model_radiance(options.material, options.source, transport);
+    // What the camera sees: the sample's light through the lens.
+    const imaging::ImageRgb radiance =
+        apply_lens(truth_radiance, transport.pixel_mm, options.lens_blur_mm, options.glare,
+                   options.glare_radius_mm);
     const double pixel_area = transport.pixel_mm * transport.pixel_mm;
     const double scale = camera_scale(camera, peak(radiance));
     summary.camera_scale = scale;
-    imaging::write_exr(out.temporary() / "truth_radiance.exr", radiance,
+    imaging::write_exr(out.temporary() / "truth_radiance.exr", truth_radiance,
                        {{"units", "radiance per unit incident power, mm^-2 sr^-1"}});
     summary.files = {"truth_radiance.exr"};
     if (monte_carlo) {
@@ -252,10 +257,14 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
     }
     json white_json = nullptr;
     if (options.white_reference) {
-      const double sigma =
-          options.white_spot_sigma_mm > 0 ? options.white_spot_sigma_mm : transport.pixel_mm;
-      const imaging::ImageRgb white = white_reference_radiance(transport.size, transport.pixel_mm,
-                                                               options.white_reflectance, sigma);
+      const double sigma = options.white_spot_sigma_mm > 0 ? options.white_spot_sigma_mm
+                           : transport.beam_sigma_mm > 0   ? transport.beam_sigma_mm
+                                                           : transport.pixel_mm;
+      // The same beam on the reference, seen through the same lens.
+      const imaging::ImageRgb white = apply_lens(
+          white_reference_radiance(transport.size, transport.pixel_mm, options.white_reflectance,
+                                   sigma),
+          transport.pixel_mm, options.lens_blur_mm, options.glare, options.glare_radius_mm);
       // The reference is far brighter than the sample: shorten its exposures by a power of two so
       // that its peak, too, fills about auto_fill of the well at the shortest one.
       const double ratio = peak(white) / peak(radiance);
@@ -290,6 +299,9 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
     truth["camera"] = camera_to_json(camera, scale);
     truth["camera"]["bracket_format"] = format == BracketFormat::kDng ? "dng" : "png";
     truth["white_reference"] = white_json;
+    truth["lens"] = {{"blur_mm", options.lens_blur_mm},
+                     {"glare", options.glare},
+                     {"glare_radius_mm", options.glare_radius_mm}};
     truth["pixel_area_mm2"] = pixel_area;
   }
   check_finite_json(truth, "truth.json");

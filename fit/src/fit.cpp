@@ -11,6 +11,7 @@
 #include "fit_solve.h"
 #include "fit_start.h"
 #include "fit_uncertainty.h"
+#include "lack_of_fit.h"
 #include "lucent/materials/error.h"
 #include "lucent/materials/tabulated.h"
 #include "lucent/materials/transport_table.h"
@@ -521,6 +522,31 @@ FitResult fit_profiles(const std::vector<ProfileData>& input, const FitOptions& 
       result.g_other = g_other;
     } catch (const Error&) {
       // A table without that g: nothing to say.
+    }
+  }
+  // A semi-infinite answer holds for samples thick enough: the thinnest slab whose profile stays
+  // within 10% of it over the data (diffusion theory). A slab thinner than that but thick enough
+  // to leave no structure the fit can see would pass for a semi-infinite sample of higher sigma_a
+  // (an 8 mm chicken slab fitted untold: sigma_a +35%), so the assumption is said.
+  if (!slab) {
+    double thinnest = 0;
+    for (int c = 0; c < 3; ++c) {
+      const ChannelFit& ch = result.chosen.channels[c];
+      if (!channels[c] || !(ch.range_end_mm > 0)) continue;
+      thinnest = std::max(thinnest, detail::thinnest_semi_infinite_mm(
+                                        ch.sigma_a, ch.sigma_s_reduced, result.chosen.eta,
+                                        ch.range_end_mm, 0.1));
+    }
+    result.assumed_thickness_mm = thinnest;
+    if (thinnest > 0) {
+      std::ostringstream note;
+      note.precision(3);
+      note << "this answer assumes a semi-infinite sample, i.e. one thicker than about "
+           << thinnest
+           << " mm (a thinner slab changes the profile by more than 10% within the data's "
+              "reach and passes for higher absorption): if it is a thinner slab, give "
+              "--thickness-mm";
+      result.notes.push_back(note.str());
     }
   }
   result.exclude_radius_mm = INFINITY;

@@ -138,7 +138,9 @@ ProfileData parse_profile_csv(std::string_view text, const std::string& source) 
     }
   }
   // thickness_mm= (inf: semi-infinite, as the simulator writes it) and side=reflected|transmitted.
-  if (auto it = meta.find("thickness_mm"); it != meta.end() && it->second != "inf") {
+  // (The simulator writes an empty value or "inf" for a semi-infinite sample.)
+  if (auto it = meta.find("thickness_mm");
+      it != meta.end() && !it->second.empty() && it->second != "inf" && it->second != "infinite") {
     const auto thickness = meta_number("thickness_mm");
     if (!(*thickness > 0 && *thickness <= 1e4))
       throw Error(source + ": comment field thickness_mm=" + it->second +
@@ -152,6 +154,35 @@ ProfileData parse_profile_csv(std::string_view text, const std::string& source) 
     d.transmitted = it->second == "transmitted";
     if (d.transmitted && !d.thickness_mm)
       throw Error(source + ": comment field side=transmitted: the far side needs thickness_mm=");
+  }
+  // The white reference's system response (acquire): rms radius and the radial profile.
+  if (auto it = meta.find("system_response_r_mm"); it != meta.end()) {
+    const auto list = [&](const std::string& key) {
+      std::vector<double> out;
+      const auto found = meta.find(key);
+      if (found == meta.end())
+        throw Error(source + ": comment field system_response_r_mm= needs system_response=");
+      for (const std::string& part : split(found->second)) {
+        double v = 0;
+        const auto [end, ec] = std::from_chars(part.data(), part.data() + part.size(), v);
+        if (ec != std::errc() || end != part.data() + part.size() || !std::isfinite(v))
+          throw Error(source + ": comment field " + key + ": expected finite numbers");
+        out.push_back(v);
+      }
+      return out;
+    };
+    d.response_r_mm = list("system_response_r_mm");
+    d.response_value = list("system_response");
+    if (d.response_r_mm.size() != d.response_value.size() || d.response_r_mm.size() < 2)
+      throw Error(source + ": comment fields system_response_r_mm= and system_response=: "
+                           "expected as many radii as values, at least 2");
+    for (std::size_t i = 1; i < d.response_r_mm.size(); ++i)
+      if (!(d.response_r_mm[i] > d.response_r_mm[i - 1]) || d.response_r_mm[0] < 0)
+        throw Error(source + ": comment field system_response_r_mm=: expected radii >= 0, rising");
+    if (auto rms = meta_number("system_response_rms_mm")) {
+      if (!(*rms >= 0)) throw Error(source + ": comment field system_response_rms_mm: expected >= 0");
+      d.response_rms_mm = *rms;
+    }
   }
   if (auto incidence = meta_number("incidence_deg")) {
     if (!(*incidence >= 0 && *incidence < 90))
@@ -272,6 +303,9 @@ ProfileData profile_data_from_json(const nlohmann::json& doc, const std::string&
   d.eta = p.ior;
   d.thickness_mm = p.thickness_mm;
   d.transmitted = p.transmitted;
+  d.response_r_mm = p.response_r_mm;
+  d.response_value = p.response_value;
+  d.response_rms_mm = p.response_rms_mm;
   d.incidence_polar_deg = p.incidence_polar_deg;
   d.incidence_azimuth_deg = p.incidence_azimuth_deg;
   d.view_deg = p.view_deg;

@@ -53,6 +53,12 @@ struct Observations {
   // `inv_se` are used, log_value holds log(max(value, se)) (sizes and plots only).
   bool linear = false;
   std::vector<double> value, inv_se, data_se;
+  // The system response (system_response.h): the model is then sum_j conv_weights[i M + j]
+  // f(conv_nodes[j]) at sample i, f the pencil-beam model at a point; empty: no convolution.
+  std::vector<double> conv_nodes, conv_weights;
+  // The response's value (per mm^2) at each sample: what the once-scattered point at the entry
+  // becomes (single_scattering_point).
+  std::vector<double> conv_point;
   int capture = 0;  // index of the profile these come from
 };
 
@@ -93,8 +99,27 @@ struct ProfileResiduals {
     }
     if (tab && oblique) dd.emplace(medium);
     const materials::TableQuantity q = detail::table_quantity(obs->geometry);
+    // With a system response: the pencil-beam model at the nodes once, then each sample a
+    // weighted sum of them (the convolution, precomputed).
+    std::vector<T> at_nodes;
+    if (!obs->conv_nodes.empty()) {
+      at_nodes.reserve(obs->conv_nodes.size());
+      for (const double s : obs->conv_nodes)
+        at_nodes.push_back(tab ? tab->at(q, T(s))
+                               : detail::model_value(model, table, medium, obs->geometry, true, s,
+                                                     s, s, s, 0.0, 0.0, gl));
+    }
+    const std::size_t m = obs->conv_nodes.size();
+    const T point = m > 0 ? detail::single_scattering_point(medium, obs->geometry) : T(0);
     for (std::size_t i = 0; i < n; ++i) {
-      const T v =
+      T convolved(0);
+      if (m > 0) {
+        const double* w = obs->conv_weights.data() + i * m;
+        for (std::size_t j = 0; j < m; ++j)
+          if (w[j] != 0) convolved += w[j] * at_nodes[j];
+        convolved += point * obs->conv_point[i];
+      }
+      const T v = m > 0 ? convolved :
           ob ? detail::oblique_pixel(*ob, q, obs->geometry, obs->x[i], obs->y[i], obs->pixel, gl)
           : tab ? (obs->radial  ? detail::tabulated_annulus(*tab, q, obs->r[i], obs->r0[i], obs->r1[i], gl)
                  : oblique ? detail::corrected_ddipole_pixel(*tab, *dd, q, obs->geometry, obs->x[i],

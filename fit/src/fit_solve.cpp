@@ -2,6 +2,7 @@
 // per-channel statistics (fit_solve.h).
 #include "fit_solve.h"
 #include "lack_of_fit.h"
+#include "system_response.h"
 
 #include <ceres/ceres.h>
 #include <ceres/covariance.h>
@@ -151,6 +152,7 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
       if (!channels[c] || !d.channels[c]) continue;
       p.observations.push_back(observations_for(d, c, exclude[c], use_2d, q, below_noise));
       Observations& o = p.observations.back();
+      attach_system_response(o, d, options.beam_sigma_mm);
       o.capture = int(di);
       if (o.log_value.empty()) continue;
       for (std::size_t i = 0; i < o.log_value.size(); ++i)
@@ -202,7 +204,7 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
       }
       const bool scale_free = scale != &p.log_scale || relative;
       if (options.loss == LossKind::kNone && !options.fit_ior && options.analytic_derivatives &&
-          model == FitModel::kDipole && !o.linear) {
+          model == FitModel::kDipole && !o.linear && o.conv_nodes.empty()) {
         problem.AddResidualBlock(new DipoleRadialCost(&o, gl, &p.eta), nullptr, p.ab[c].data(),
                                  scale);
         record(c, &o, int(o.log_value.size()));
@@ -235,6 +237,10 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
           pick(one.value);
           pick(one.inv_se);
           pick(one.data_se);
+          pick(one.conv_point);
+          if (const std::size_t m = one.conv_nodes.size(); m > 0)
+            one.conv_weights.assign(o.conv_weights.begin() + long(i * m),
+                                    o.conv_weights.begin() + long((i + 1) * m));
           auto* cost = new ceres::AutoDiffCostFunction<ProfileResiduals, ceres::DYNAMIC, 2, 1, 1>(
               new ProfileResiduals{&one, model, gl, table, perturbation}, 1);
           ceres::LossFunction* loss =

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace lucent::fit::detail {
@@ -83,6 +84,43 @@ std::string lack_of_fit_reason(const RadialStructure& s, char channel) {
                   "or g (--g), or a sample that is not a homogeneous slab");
   }
   return why.str();
+}
+
+}  // namespace lucent::fit::detail
+
+namespace lucent::fit::detail {
+
+double thinnest_semi_infinite_mm(double sigma_a, double sigma_s_reduced, double eta, double reach_mm,
+                                 double tolerance) {
+  const double st = sigma_a + sigma_s_reduced;
+  if (!(st > 0) || !(reach_mm > 0)) return 0;
+  const double D = 1 / (3 * st), sigma_tr = std::sqrt(3 * sigma_a * st), z_r = 1 / st;
+  const double eta2 = eta * eta;
+  const double f_dr = eta >= 1 ? -1.440 / eta2 + 0.710 / eta + 0.668 + 0.0636 * eta
+                               : -0.4399 + 0.7099 / eta - 0.3319 / eta2 + 0.0636 / (eta2 * eta);
+  const double z_b = 2 * (1 + f_dr) / (1 - f_dr) * D;  // extrapolated boundary distance
+  // One source at depth z (positive: real, negative: image) seen at radius r on the surface.
+  const auto term = [&](double z, double r) {
+    const double d = std::sqrt(r * r + z * z);
+    return z * (1 + sigma_tr * d) * std::exp(-sigma_tr * d) / (d * d * d);
+  };
+  const auto semi = [&](double r) { return term(z_r, r) + term(z_r + 2 * z_b, r); };
+  const auto slab = [&](double r, double thickness) {
+    const double period = 2 * (thickness + 2 * z_b);
+    double sum = 0;
+    for (int i = -20; i <= 20; ++i) {
+      // Sources at 2 i (d + 2 z_b) + z_r, images at 2 i (d + 2 z_b) - z_r - 2 z_b.
+      sum += term(i * period + z_r, r) - term(i * period - z_r - 2 * z_b, r);
+    }
+    return sum;
+  };
+  for (double d = 0.25; d <= 1e4; d *= 1.1) {
+    bool holds = true;
+    for (double r = reach_mm / 8; r <= reach_mm * 1.0001 && holds; r *= 1.25)
+      holds = std::abs(slab(r, d) / semi(r) - 1) <= tolerance;
+    if (holds) return d;
+  }
+  return std::numeric_limits<double>::infinity();
 }
 
 }  // namespace lucent::fit::detail

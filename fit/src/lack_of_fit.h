@@ -48,3 +48,15 @@ inline constexpr double kMaxStructureZ = 4.0;
 std::string lack_of_fit_reason(const RadialStructure& s, char channel);
 
 }  // namespace lucent::fit::detail
+
+namespace lucent::fit::detail {
+
+/// The thinnest slab whose profile stays within `tolerance` (relative) of the semi-infinite
+/// sample's out to reach_mm, for a medium of these coefficients, by diffusion theory (the
+/// standard dipole and its slab's image series, extrapolated boundaries): a fit that assumed a
+/// semi-infinite sample holds only for samples thicker than this. mm; infinity when even 10 m is
+/// not enough.
+double thinnest_semi_infinite_mm(double sigma_a, double sigma_s_reduced, double eta, double reach_mm,
+                                 double tolerance);
+
+}  // namespace lucent::fit::detail

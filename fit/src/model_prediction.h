@@ -72,6 +72,34 @@ T fresnel_factor(const CaptureGeometry& g, const T& eta, FitModel model) {
   return front * fresnel_transmittance(T(g.cos_view), eta);
 }
 
+/// The light scattered once from a normal pencil beam straight back along the normal (or, on a
+/// slab's far side, straight on through it): a point at the entry (exit) point, which the
+/// transport table, binned in radius, does not hold. A pencil beam leaves it inside the exclusion
+/// radius; a beam of finite width spreads it into the shape of its footprint. Its pi L per unit
+/// power entering, times the point's delta (per mm^2): pi omega p_HG(-1) T(1) / (2 eta^2)
+/// (1 - e^(-2 sigma_t d)) on the lit side, pi omega p_HG(1) T(1) / eta^2 sigma_t d e^(-sigma_t d)
+/// on the far side; exitance data hold none (once-scattered light leaves displaced).
+template <typename T>
+T single_scattering_point(const materials::Medium<T>& m, const CaptureGeometry& g) {
+  using std::exp;
+  if (g.exitance) return T(0);
+  const T sigma_t = m.sigma_a + m.sigma_s;
+  if (!(sigma_t > T(0))) return T(0);
+  const T omega = m.sigma_s / sigma_t;
+  const T transmit = materials::fresnel_transmittance(T(1), T(1) / m.eta) / (m.eta * m.eta);
+  const auto hg = [&](const T& mu) {  // Henyey-Greenstein at cos theta = mu
+    const T g2 = m.g * m.g;
+    const T denom = T(1) + g2 - T(2) * m.g * mu;
+    return (T(1) - g2) / (T(4 * std::numbers::pi) * denom * sqrt(denom));
+  };
+  const bool slab = g.thickness_mm < std::numeric_limits<double>::infinity();
+  const T d = T(slab ? g.thickness_mm : 0.0);
+  if (g.transmitted)
+    return T(std::numbers::pi) * omega * hg(T(1)) * transmit * sigma_t * d * exp(-sigma_t * d);
+  return T(std::numbers::pi) * omega * hg(T(-1)) * transmit / T(2) *
+         (slab ? T(1) - exp(T(-2) * sigma_t * d) : T(1));
+}
+
 /// The table's quantity for the data's.
 inline materials::TableQuantity table_quantity(const CaptureGeometry& g) {
   return g.exitance ? materials::TableQuantity::kExitance : materials::TableQuantity::kRadiance;

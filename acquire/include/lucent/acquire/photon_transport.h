@@ -44,6 +44,9 @@ struct PhotonTransportOptions {
   /// the totals (transmittance) but not in the bins or the image (a point at the centre). Needs a
   /// finite thickness.
   bool far_side = false;
+  /// A beam of finite width: each photon enters at a point drawn from a round Gaussian of this
+  /// sigma (mm) about the origin; 0: a pencil beam.
+  double beam_sigma_mm = 0;
   /// Polar angle of the incident beam from the surface normal, degrees, in [0, 90).
   double incidence_deg = 0;
   /// Azimuth of the beam's direction of travel in the surface plane, degrees from +x: at 0 the beam

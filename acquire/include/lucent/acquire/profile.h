@@ -61,6 +61,11 @@ struct Profile {
   std::optional<double> ior;  ///< the sample's relative index when the capture states it
   std::optional<double> thickness_mm;  ///< a slab's thickness, mm, when the capture states it
   bool transmitted = false;            ///< the far side of the slab (transmittance)
+  /// The system response the white reference recorded (beam footprint, lens blur, glare, pixel):
+  /// its radial profile about its own centre, per mm^2 with unit integral over the plane, and its
+  /// rms radius (mm). Empty without a white reference.
+  std::vector<double> response_r_mm, response_value;
+  double response_rms_mm = 0;
   /// Entry point in pixels; pixel (i, j) covers [i, i + 1) x [j, j + 1), its centre is (i + 0.5, j
   /// + 0.5).
   std::array<double, 2> beam_point_px{};

@@ -36,8 +36,16 @@ struct SimulateOptions {
   double white_reflectance = 0.99;
   /// Beam radius (1/e^2 half width / 2, i.e. the Gaussian sigma) on the white reference, mm; the
   /// pencil beam of the sample simulation is idealised, a reference spot needs some width to be
-  /// imaged. 0 = one pixel pitch.
+  /// imaged. 0 = one pixel pitch, or the beam's own sigma when it has one (transport.beam_sigma_mm:
+  /// the same beam lights the reference).
   double white_spot_sigma_mm = 0;
+  /// The lens: a Gaussian blur of this sigma (mm on the sample), and veiling glare, the fraction
+  /// `glare` of every pixel's light spread over the field by the kernel a / (2 pi (r^2 + a^2)^1.5)
+  /// (a = glare_radius_mm; unit integral, tails as 1 / r^3). Both act on the sample's and the
+  /// white reference's images alike (and not on truth_radiance.exr, the light leaving the sample).
+  double lens_blur_mm = 0;
+  double glare = 0;
+  double glare_radius_mm = 1;
   bool dark_frame = true;
   BracketFormat bracket_format = BracketFormat::kPng;
   bool profile_only = false;  ///< skip the images (transport without camera)
@@ -68,5 +76,11 @@ imaging::ImageRgb model_radiance(const materials::Material& material, RadianceSo
 /// so that the image integrated over the plane is rho / pi exactly, up to the spot's tail beyond
 /// the grid.
 imaging::ImageRgb white_reference_radiance(int size, double pixel_mm, double rho, double sigma_mm);
+
+/// The image through a lens (SimulateOptions): a Gaussian blur of blur_mm, then the fraction
+/// `glare` spread by the veiling-glare kernel of radius glare_radius_mm. Radiance per pixel in,
+/// the same out (energy kept but for what leaves the field). Throws lucent::Error on bad values.
+imaging::ImageRgb apply_lens(const imaging::ImageRgb& image, double pixel_mm, double blur_mm,
+                             double glare, double glare_radius_mm);
 
 }  // namespace lucent::acquire

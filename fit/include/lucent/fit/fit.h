@@ -49,6 +49,10 @@ struct FitOptions {
   /// when any input is a slab. The lit side's nodes without the semi-infinite one (the fit adds
   /// its own table's).
   std::shared_ptr<const materials::SlabNodes> slab;
+  /// The beam (and lens) as a round Gaussian of this sigma, mm, for every input, over any system
+  /// response the inputs carry; 0: each input's measured response (the white reference's) where
+  /// it is wider than the pixels (rms radius above 1.5 pixels), else a pencil beam.
+  double beam_sigma_mm = 0;
   /// An oblique table (lucent tabulate --incidence-deg) holding the slice at the data's eta, g
   /// and incidence: 2D oblique data are then fitted with it, exact to transport. Null, or no
   /// such slice: the directional dipole corrected by the radial table (a note says so).
@@ -170,6 +174,8 @@ struct FitResult {
   /// one (tightest band, then smallest radius). "" when not judged.
   std::string fallback_model;
   double g = 0;                         ///< the g the tabulated model assumed
+  /// A semi-infinite fit: the thinnest sample for which that answer holds (mm; 0 for a slab fit).
+  double assumed_thickness_mm = 0;
   /// Per channel {sigma_a, sigma_s'} of the tabulated fit at g = g_other (0.9, or 0 when the fit
   /// assumed g >= 0.45): how far the answer moves with the assumed g. Empty when not computed.
   std::vector<std::array<double, 2>> g_09;

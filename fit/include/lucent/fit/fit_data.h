@@ -56,6 +56,10 @@ struct ProfileData {
   /// lit one (reflectance) or the far one (transmittance).
   std::optional<double> thickness_mm;
   bool transmitted = false;
+  /// The system response the white reference recorded (beam footprint, lens blur and glare, the
+  /// pixel): radial, per mm^2, unit integral; and its rms radius, mm. Empty when not measured.
+  std::vector<double> response_r_mm, response_value;
+  double response_rms_mm = 0;
   RadialBins radial;
   std::optional<Samples2d> samples_2d;
   std::array<bool, 3> channels{true, true, true};  ///< which channels carry data
