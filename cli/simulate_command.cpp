@@ -119,13 +119,10 @@ std::vector<double> parse_exposures(const std::string& text) {
 void run(SimulateArguments& args) {
   acquire::SimulateOptions& o = args.options;
   o.material = materials::load_material(args.material);
-  {
-    const Field field = default_field(o.material, o.transport.size, o.transport.pixel_mm,
-                                      args.size_given, args.pixel_given);
-    o.transport.size = field.size;
-    o.transport.pixel_mm = field.pixel_mm;
-    if (!field.why.empty() && !args.quiet && !args.json) std::cerr << field.why << '\n';
-  }
+  const Field field = default_field(o.material, o.transport.size, o.transport.pixel_mm,
+                                    args.size_given, args.pixel_given);
+  o.transport.size = field.size;
+  o.transport.pixel_mm = field.pixel_mm;
   if (args.bracket_format == "png")
     o.bracket_format = acquire::BracketFormat::kPng;
   else if (args.bracket_format == "dng")
@@ -166,6 +163,8 @@ void run(SimulateArguments& args) {
   const auto progress = [&](std::uint64_t done, std::uint64_t total) { line.update(done, total); };
   const acquire::SimulateSummary summary = acquire::run_simulation(o, args.output, progress);
   line.finish();
+  // Said once the options have passed (a refusal stays one line).
+  if (!field.why.empty() && !args.quiet && !args.json) std::cerr << field.why << '\n';
 
   const auto& t = summary.transport;
   if (args.json) {

@@ -137,21 +137,28 @@ SystemResponse white_reference_response(const HdrResult& white, const BeamPower&
   cx /= total, cy /= total;
   const double reach = std::min({cx, cy, w - cx, h - cy});
   const int rings = std::max(1, int(2 * reach));
-  std::vector<double> sum(std::size_t(rings), 0.0), count(std::size_t(rings), 0.0);
+  std::vector<double> sum(std::size_t(rings), 0.0), sum2(std::size_t(rings), 0.0),
+      count(std::size_t(rings), 0.0);
   double all = 0, second = 0;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const double d = std::hypot(x + 0.5 - cx, y + 0.5 - cy), s = v[std::size_t(y) * w + x];
       all += s, second += s * d * d;
       const int k = int(2 * d);
-      if (k < rings) sum[std::size_t(k)] += s, count[std::size_t(k)] += 1;
+      if (k < rings) sum[std::size_t(k)] += s, sum2[std::size_t(k)] += s * s, count[std::size_t(k)] += 1;
     }
   if (!(all > 0)) return r;
   const double area = pixel_mm * pixel_mm;
   for (int k = 0; k < rings; ++k) {
-    if (count[std::size_t(k)] == 0) continue;
+    const double n = count[std::size_t(k)];
+    if (n == 0) continue;
+    const double mean = sum[std::size_t(k)] / n;
+    const double se = n > 1 ? std::sqrt(std::max(0.0, sum2[std::size_t(k)] / n - mean * mean) / (n - 1))
+                            : INFINITY;
     r.r_mm.push_back((k + 0.5) * 0.5 * pixel_mm);
-    r.value.push_back(sum[std::size_t(k)] / count[std::size_t(k)] / (all * area));
+    // A ring no brighter than 3 of its standard errors is the dark field's noise, not light: 0
+    // (the profile spans six decades; a floor of noise would be a veil over its tail).
+    r.value.push_back(mean > 3 * se ? mean / (all * area) : 0.0);
   }
   r.rms_mm = std::sqrt(std::max(0.0, second / all)) * pixel_mm;
   return r;

@@ -12,6 +12,7 @@
 #include "fit_start.h"
 #include "fit_uncertainty.h"
 #include "lack_of_fit.h"
+#include "system_response.h"
 #include "lucent/materials/error.h"
 #include "lucent/materials/tabulated.h"
 #include "lucent/materials/transport_table.h"
@@ -523,6 +524,16 @@ FitResult fit_profiles(const std::vector<ProfileData>& input, const FitOptions& 
     } catch (const Error&) {
       // A table without that g: nothing to say.
     }
+  }
+  // Which inputs' model was convolved with a system response, and with what.
+  for (const ProfileData& d : data) {
+    detail::Observations probe;
+    probe.r = {1.0};
+    const std::string what = detail::attach_system_response(probe, d, options.beam_sigma_mm);
+    result.notes.push_back(d.source + ": " +
+                           (what.empty() ? std::string("a pencil beam and a sharp lens assumed (no "
+                                                       "system response wider than the pixels)")
+                                         : "the model is convolved with " + what));
   }
   // A semi-infinite answer holds for samples thick enough: the thinnest slab whose profile stays
   // within 10% of it over the data (diffusion theory). A slab thinner than that but thick enough

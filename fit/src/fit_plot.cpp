@@ -1,4 +1,5 @@
 #include "lucent/fit/fit_plot.h"
+#include "system_response.h"
 
 #include <algorithm>
 #include <cmath>
@@ -27,8 +28,30 @@ double predicted_radial(const ModelFit& fit, const ProfileData& data, int c, dou
   // What the fit compares with: a pixel footprint at r when the bins are pixel averages.
   const detail::GaussLegendre gl = detail::gauss_legendre(2);
   const double p = data.radial.pixel_mm;
+  const double front =
+      fit.scale * fit.calibration_scale[c] * detail::fresnel_factor(g, fit.eta, fit.model);
+  // A system response (the white reference's, or the fit's --beam-sigma-mm): the fit's own
+  // convolved model at r, through its residual functor (log data 0, weight 1: the residual is the
+  // log of the prediction).
+  detail::Observations o;
+  o.geometry = detail::geometry_of(data);
+  o.r = o.r0 = o.r1 = o.x = {r};
+  o.y = {0.0};
+  o.pixel = p;
+  o.radial = !(p > 0);
+  o.log_value = {0.0};
+  o.inv_rel_se = {1.0};
+  o.data_rel_se = {1.0};
+  if (!detail::attach_system_response(o, data, fit.beam_sigma_mm).empty()) {
+    const detail::ProfileResiduals model{&o, fit.model, gl, table};
+    const double ab[2] = {std::log(fit.channels[c].sigma_a),
+                          std::log(fit.channels[c].sigma_s_reduced)};
+    double log_v = 0;
+    model.evaluate(ab, std::log(fit.scale * fit.calibration_scale[c]), fit.eta, &log_v);
+    return std::exp(log_v);
+  }
   const double v = detail::model_value(fit.model, table, medium, g, false, r, r, r, r, 0.0, p, gl);
-  return fit.scale * fit.calibration_scale[c] * detail::fresnel_factor(g, fit.eta, fit.model) * v;
+  return front * v;
 }
 
 void check_fit_plot_path(const std::filesystem::path& path, const std::string& option) {

@@ -366,6 +366,7 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
   fit.time_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
+  fit.beam_sigma_mm = options.beam_sigma_mm;
   fit.converged = summary.termination_type == ceres::CONVERGENCE;
   fit.iterations = int(summary.iterations.size()) - 1;
   fit.message = summary.message;

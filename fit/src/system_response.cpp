@@ -26,6 +26,29 @@ double bessel_i0e(double x) {
          std::sqrt(x);
 }
 
+bool response_is_wide(const ProfileData& d) {
+  const std::vector<double>& r = d.response_r_mm;
+  const std::vector<double>& v = d.response_value;
+  if (r.size() < 2 || r.size() != v.size()) return false;
+  const double pixel = d.radial.pixel_mm;
+  // The rings as annuli about their radii (rings of equal width), down to where the response
+  // falls below 1e-4 of its peak: the noise of the white reference's dark field must not pass for
+  // width (its r^2-weighted sum is large and of either sign).
+  const double peak = *std::max_element(v.begin(), v.end());
+  double energy = 0, second = 0, outside = 0;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    const double width = i + 1 < r.size() ? r[i + 1] - r[i] : r[i] - r[i - 1];
+    const double ring = 2 * std::numbers::pi * r[i] * width * std::max(0.0, v[i]);
+    if (v[i] >= 1e-4 * peak) energy += ring, second += ring * r[i] * r[i];
+    if (pixel > 0 && r[i] > 3 * pixel) outside += ring;  // glare, whatever its level
+  }
+  if (!(energy > 0)) return false;
+  const double rms = std::sqrt(second / energy);
+  // Wider than the pixels' own footprint (a pencil beam through a sharp lens gives a spot of about
+  // one pixel sigma: rms 1.4-1.5 pixels, 1.1% of it beyond 3 pixels), or a glare veil of 2% or more.
+  return pixel > 0 ? rms > 2 * pixel || outside > 0.02 : rms > 0;
+}
+
 std::string attach_system_response(Observations& o, const ProfileData& d, double beam_sigma_mm) {
   o.conv_nodes.clear();
   o.conv_weights.clear();
@@ -33,8 +56,7 @@ std::string attach_system_response(Observations& o, const ProfileData& d, double
   if (o.linear || o.r.empty()) return "";
   const double pixel = d.radial.pixel_mm;
   const bool gaussian = beam_sigma_mm > 0;
-  const bool measured = !gaussian && d.response_r_mm.size() >= 2 &&
-                        d.response_rms_mm > (pixel > 0 ? 1.5 * pixel : 0.0);
+  const bool measured = !gaussian && response_is_wide(d);
   if (!gaussian && !measured) return "";
   const double sigma =
       gaussian ? std::sqrt(beam_sigma_mm * beam_sigma_mm + (pixel > 0 ? pixel * pixel / 12 : 0.0))
@@ -102,7 +124,7 @@ std::string attach_system_response(Observations& o, const ProfileData& d, double
     what << "a Gaussian beam of sigma " << beam_sigma_mm << " mm (--beam-sigma-mm)";
   else
     what << "the system response the white reference recorded (rms radius " << d.response_rms_mm
-         << " mm)";
+         << " mm over the whole field)";
   return what.str();
 }
 

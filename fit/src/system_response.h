@@ -20,10 +20,14 @@ namespace lucent::fit::detail {
 /// e^-x I0(x), x >= 0 (Abramowitz and Stegun 9.8.1-2, relative error below 2e-7).
 double bessel_i0e(double x);
 
+/// Whether the data's measured response is more than its pixels make: its core's rms radius (the
+/// rings above 1e-4 of the peak) above 2 pixels, or 2% of it beyond 3 pixels (glare).
+bool response_is_wide(const ProfileData& d);
+
 /// Fills o.conv_nodes and o.conv_weights for radial bins (o.r) when a response applies: a
 /// Gaussian of beam_sigma_mm (> 0; with the pixel's own spread added for pixel bins), else the
-/// data's measured response when it is wider than the pixels (rms radius above 1.5 pixels, or
-/// any for bins without pixels). Returns what was applied, for the report ("" when nothing).
+/// data's measured response when response_is_wide. Returns what was applied, for the report (""
+/// when nothing).
 std::string attach_system_response(Observations& o, const ProfileData& d, double beam_sigma_mm);
 
 }  // namespace lucent::fit::detail

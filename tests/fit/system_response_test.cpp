@@ -77,10 +77,20 @@ TEST(SystemResponse, MeasuredResponseIsUsedWhenWiderThanThePixels) {
   // The measured response is linear between rings 0.05 mm apart: measured 0.45% at the centre,
   // 1% where the 0.5 mm Gaussian has fallen to 1e-4 of its peak.
   EXPECT_LT(worst, 1.2e-2);
-  // No wider than the pixels' own footprint (rms below 1.5 pixels): not applied.
-  d.response_rms_mm = 0.12;
+  // A spot of one pixel sigma (a pencil beam imaged by the pixels): not applied; with 3% of its
+  // light spread far out (glare), applied.
+  d.response_value.clear();
+  for (double r : d.response_r_mm) d.response_value.push_back(gauss2d(r, 0.1));
+  EXPECT_FALSE(response_is_wide(d));
   EXPECT_TRUE(attach_system_response(o, d, 0).empty());
   EXPECT_TRUE(o.conv_nodes.empty());
+  for (std::size_t i = 0; i < d.response_r_mm.size(); ++i) {
+    const double r = d.response_r_mm[i], a = 1.0;
+    d.response_value[i] = 0.97 * gauss2d(r, 0.1) +
+                          0.03 * a / (2 * std::numbers::pi * std::pow(r * r + a * a, 1.5));
+  }
+  EXPECT_TRUE(response_is_wide(d));
+  EXPECT_FALSE(attach_system_response(o, d, 0).empty());
 }
 
 }  // namespace

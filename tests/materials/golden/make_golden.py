@@ -3,7 +3,9 @@
 
 The directional dipole here follows the structure of Frisvad, Hachisuka and Kjeldsen's own sample
 code (profile function Sp_d, modified normal, real/virtual source distances), written separately
-from the C++ in materials/ so that a transcription error in either shows up as a mismatch.
+from the C++ in materials/ so that a transcription error in either shows up as a mismatch. One
+departure from the sample code: below eta = 1 the second Fresnel moment is its definition
+integrated here (the code's fit is wrong there), as lucent computes it.
 Run: python3 make_golden.py > golden_bssrdf.csv
 """
 import math
@@ -22,7 +24,28 @@ def C1(n):
         return (-9.23372 + 22.2272*n - 20.9292*n**2 + 10.2291*n**3 - 2.54396*n**4 + 0.254913*n**5) / 2
     return (0.919317 - 3.4793*n + 6.75335*n**2 - 7.80989*n**3 + 4.98554*n**4 - 1.36881*n**5) / 2
 
+def fresnel_R(cos_i, eta):
+    """Unpolarised Fresnel reflectance, light arriving at cos_i, relative index eta = n_t / n_i."""
+    sin2_t = (1 - cos_i*cos_i) / (eta*eta)
+    if sin2_t >= 1: return 1.0
+    cos_t = math.sqrt(1 - sin2_t)
+    rs = (cos_i - eta*cos_t) / (cos_i + eta*cos_t)
+    rp = (eta*cos_i - cos_t) / (eta*cos_i + cos_t)
+    return 0.5*(rs*rs + rp*rp)
+
 def C2(n):
+    if n < 1.0:
+        # The sample code's single fit is not the moment below 1 (C_E(0.8) = 0.12 for 0.486): the
+        # definition, integral of F_r(mu, 1/n) mu^2 dmu over [0, 1], by composite Simpson (4000
+        # intervals; no total internal reflection from the optically thinner side).
+        m = 4000
+        h = 1.0 / m
+        total = 0.0
+        for k in range(m + 1):
+            mu = k * h
+            w = 1 if k in (0, m) else (4 if k % 2 else 2)
+            total += w * fresnel_R(mu, 1.0/n) * mu*mu
+        return total * h / 3
     return (-1641.1 + 1213.67*n - 568.556*n**2 + 164.798*n**3 - 27.0181*n**4 + 1.91826*n**5
             + 1376.53/n - 656.175/n**2 + 135.926/n**3) / 3
 

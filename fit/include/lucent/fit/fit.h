@@ -131,6 +131,8 @@ struct ModelFit {
   double eta = 1.3;
   double sd_eta = 0;
   double scale = 1.0, sd_scale = 0;  ///< global scale (1 when calibrated and not fitted)
+  /// The Gaussian beam the fit assumed (FitOptions::beam_sigma_mm; 0: the data's own response).
+  double beam_sigma_mm = 0;
   /// Per channel, the first input's calibration scale as fitted within its prior (1 when exact).
   std::array<double, 3> calibration_scale{1.0, 1.0, 1.0};
   bool converged = false;
