@@ -91,7 +91,8 @@ BENCHMARK(BM_TabulatedFit150Bins)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond)
 // a system response (a 0.5 mm Gaussian beam: the convolution is a precomputed linear map from the
 // model at ~500 radii to the bins; arg 0), and of a 5 mm slab (arg 1: slab tables of 10^5 photons
 // per node built once outside the loop, about 15 s). The data are each model's own (the slab's
-// from its own tables, the beam's by the same convolution done here by quadrature).
+// from its own tables, the beam's by the same convolution done here by quadrature, with the
+// once-scattered point at the entry spread by the beam).
 double i0e(double x) {  // e^-x I0(x) by its series (x small) or asymptotics (x large)
   if (x < 30) {
     double sum = 0, term = 1;
@@ -151,6 +152,12 @@ void BM_RealBenchFit150Bins(benchmark::State& state) {
               m, c, materials::DiffusionModel::kTabulated, materials::TableQuantity::kRadiance, s);
           v += 0.005 * s * f * std::exp(-(r - s) * (r - s) / (2 * s2)) * i0e(r * s / s2) / s2;
         }
+        // The once-scattered point at the entry, spread by the beam (what the fit adds too).
+        const double sa = m.sigma_a[c], ss = m.sigma_s_reduced[c];
+        const double point = std::numbers::pi * ss / (sa + ss) / (4 * std::numbers::pi) *
+                             materials::fresnel_transmittance(1.0, 1 / m.ior) /
+                             (2 * m.ior * m.ior);
+        v += point * std::exp(-r * r / (2 * s2)) / (2 * std::numbers::pi * s2);
         d.radial.value[c][i] = ft * v;
         d.radial.standard_error[c][i] = 0.01 * ft * v;
       }
