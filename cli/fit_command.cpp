@@ -143,7 +143,10 @@ materials::Material run(const FitArguments& a) {
   if (!a.plot.empty()) {
     fit::FitPlotOptions plot_options;
     plot_options.log_r = a.plot_log_r;
-    fit::write_fit_plot(a.plot, result, data.front(), plot_options);
+    // The plot's model is the fit's: the thickness the options gave every input included.
+    fit::ProfileData plotted = data.front();
+    if (options.thickness_mm) plotted.thickness_mm = options.thickness_mm;
+    fit::write_fit_plot(a.plot, result, plotted, plot_options);
   }
   if (!a.report.empty()) {
     const nlohmann::json report = fit::fit_report(result, data, options);

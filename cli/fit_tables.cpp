@@ -203,7 +203,7 @@ std::shared_ptr<const materials::SlabNodes> slab_nodes_for(const std::vector<fit
     for (const double t : slab_thickness_nodes()) {
       std::ostringstream name;
       name.precision(12);
-      name << "slab1-eta" << *eta << "-g" << g << "-t" << t << "-"
+      name << "slab2-eta" << *eta << "-g" << g << "-t" << t << "-"
            << (transmitted ? "transmitted" : "reflected") << "-n" << photons << ".lut";
       std::shared_ptr<const materials::TabulatedProfile>& profile = kept[name.str()];
       if (!profile) {
@@ -213,6 +213,8 @@ std::shared_ptr<const materials::SlabNodes> slab_nodes_for(const std::vector<fit
         o.photons = photons;
         o.white_photons = std::clamp(std::uint64_t(double(photons) * 1.5 * (1 - g)),
                                      std::uint64_t(o.groups) * 64, photons);
+        // Near-black nodes down to alpha' 2e-4, as for a radial slice (high-g media need them).
+        o.grid = radial_fit_grid();
         o.thickness_s = t;
         o.transmitted = transmitted;
         const auto has = [&](const materials::TransportTable& table) {

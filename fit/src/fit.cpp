@@ -378,7 +378,11 @@ FitResult fit_profiles(const std::vector<ProfileData>& input, const FitOptions& 
     } else if (slab) {
       std::ostringstream why;
       why << "tabulated: exact to radiative transfer for a slab of "
-          << (options.thickness_mm ? *options.thickness_mm : *data.front().thickness_mm)
+          << [&] {
+               for (const ProfileData& d : data)
+                 if (d.thickness_mm) return *d.thickness_mm;
+               return 0.0;
+             }()
           << " mm under a normal pencil beam (lucent's Monte Carlo slab tables at g = "
           << g_text(options.g) << "); the diffusion models, of a semi-infinite sample, are not "
           << "judged";
@@ -483,6 +487,29 @@ FitResult fit_profiles(const std::vector<ProfileData>& input, const FitOptions& 
     }
   }
   detail::finish_uncertainty(result, options, channels);
+  // A slab beyond the thickness nodes is clamped to the nearest: said, with the numbers.
+  if (slab && options.slab) {
+    const auto& lit = options.slab->log_thickness_s;
+    const auto& far = options.slab->log_thickness_s_transmitted;
+    for (const ProfileData& d : data) {
+      if (!d.thickness_mm) continue;
+      const std::vector<double>& x = d.transmitted ? far : lit;
+      if (x.empty()) continue;
+      for (int c = 0; c < 3; ++c) {
+        if (!channels[c] || !d.channels[c]) continue;
+        const double t = *d.thickness_mm * result.chosen.channels[c].sigma_s_reduced;
+        if (t >= std::exp(x.front()) * 0.999 && (!d.transmitted || t <= std::exp(x.back()) * 1.001))
+          continue;
+        std::ostringstream w;
+        w.precision(3);
+        w << d.source << ": channel " << "RGB"[c] << ": the slab is " << t
+          << " reduced scattering lengths thick (d sigma_s'), outside the slab tables' "
+          << std::exp(x.front()) << ".." << std::exp(x.back())
+          << "; the model there is the nearest table's: distrust this channel";
+        result.warnings.push_back(w.str());
+      }
+    }
+  }
   if (slab && options.systematics)
     result.notes.push_back(
         "a slab: no cheaper model is judged (the dipoles are of a semi-infinite sample), and the "

@@ -110,7 +110,15 @@ struct ProfileResiduals {
                                                      s, s, s, 0.0, 0.0, gl));
     }
     const std::size_t m = obs->conv_nodes.size();
-    const T point = m > 0 ? detail::single_scattering_point(medium, obs->geometry) : T(0);
+    // The once-scattered point, for the accurate model (which holds single scattering), at the
+    // table's g: sigma_s = sigma_s' / (1 - g) (the diffusion models have no single scattering).
+    T point(0);
+    if (m > 0 && model == FitModel::kTabulated && table) {
+      const double g = table->g();
+      point = detail::single_scattering_point(
+          materials::Medium<T>{medium.sigma_a, medium.sigma_s / T(1 - g), T(g), eta},
+          obs->geometry);
+    }
     for (std::size_t i = 0; i < n; ++i) {
       T convolved(0);
       if (m > 0) {

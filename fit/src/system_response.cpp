@@ -66,7 +66,7 @@ std::string attach_system_response(Observations& o, const ProfileData& d, double
   // The measured response at radius x (linear between its rings, its first value inside them, 0
   // beyond the last).
   const auto kernel = [&](double x) {
-    if (x <= kr.front()) return kv.front();
+    if (x <= kr.front()) return std::max(0.0, kv.front());
     if (x >= kr.back()) return 0.0;
     const auto hi = std::size_t(std::upper_bound(kr.begin(), kr.end(), x) - kr.begin());
     const double t = (x - kr[hi - 1]) / (kr[hi] - kr[hi - 1]);

@@ -51,7 +51,8 @@ struct FitOptions {
   std::shared_ptr<const materials::SlabNodes> slab;
   /// The beam (and lens) as a round Gaussian of this sigma, mm, for every input, over any system
   /// response the inputs carry; 0: each input's measured response (the white reference's) where
-  /// it is wider than the pixels (rms radius above 1.5 pixels), else a pencil beam.
+  /// it is wider than the pixels (its core's rms radius above 2 pixels, or 2% glare), else a
+  /// pencil beam.
   double beam_sigma_mm = 0;
   /// An oblique table (lucent tabulate --incidence-deg) holding the slice at the data's eta, g
   /// and incidence: 2D oblique data are then fitted with it, exact to transport. Null, or no
