@@ -41,6 +41,7 @@ struct FitArguments {
   double thickness_mm = 0;  // 0: not given
   double beam_sigma_mm = 0;  // 0: not given
   bool fit_ior = false, relative = false, json = false, allow_unconverged = false;
+  bool fit_thickness = false;
   bool plot_log_r = false;  // --plot-log-r
 };
 
@@ -91,6 +92,9 @@ fit::FitOptions to_options(const FitArguments& a) {
   // Given or not is what counts (the validators have checked the values): no value falls back.
   if (a.exclude_option && a.exclude_option->count() > 0) o.exclude_radius_mm = a.exclude_radius_mm;
   if (a.thickness_mm > 0) o.thickness_mm = a.thickness_mm;
+  o.fit_thickness = a.fit_thickness;
+  if (o.fit_thickness && o.thickness_mm)  // before any slab table is built
+    throw Error("--fit-thickness: the thickness is either given (--thickness-mm) or fitted, not both");
   o.beam_sigma_mm = a.beam_sigma_mm;
   if (a.row_ior || (a.ior_option && a.ior_option->count() > 0)) {
     if (!(a.ior > 0 && a.ior <= 4)) throw Error("--ior: expected a relative index in (0, 4]");
@@ -146,6 +150,8 @@ materials::Material run(const FitArguments& a) {
     // The plot's model is the fit's: the thickness the options gave every input included.
     fit::ProfileData plotted = data.front();
     if (options.thickness_mm) plotted.thickness_mm = options.thickness_mm;
+    if (result.thickness && std::isfinite(result.thickness->thickness_mm))
+      plotted.thickness_mm = result.thickness->thickness_mm;
     fit::write_fit_plot(a.plot, result, plotted, plot_options);
   }
   if (!a.report.empty()) {
@@ -179,6 +185,17 @@ materials::Material run(const FitArguments& a) {
               << ch.sd_sys_sigma_s_reduced << "), " << ch.samples << " samples over "
               << ch.exclude_radius_mm << ".." << ch.range_end_mm << " mm, reduced chi^2 "
               << ch.reduced_chi2 << "\n";
+  }
+  if (result.thickness) {
+    const fit::ThicknessFit& t = *result.thickness;
+    if (t.determined)
+      std::cout << "  thickness: " << t.thickness_mm << " mm (1 SD " << t.lower_mm << ".."
+                << t.upper_mm << " mm)\n";
+    else if (!std::isfinite(t.upper_mm))
+      std::cout << "  thickness: undetermined, any above " << t.lower_mm
+                << " mm fits (the data look semi-infinite)\n";
+    else
+      std::cout << "  thickness: undetermined, any below " << t.upper_mm << " mm fits\n";
   }
   if (!result.g_09.empty()) {
     std::cout << "  assumed g = " << result.g << "; at g = " << result.g_other
@@ -321,6 +338,10 @@ void register_fit_command(CLI::App& app) {
                   "input says, thickness_mm and side, else semi-infinite); its tables are built "
                   "on first use and kept in ~/.cache/lucent")
       ->check(number_in(1e-3, 1e4, "mm"));
+  cmd->add_flag("--fit-thickness", args->fit_thickness,
+                "the sample is a slab of unknown thickness: fit it (one for every input) and say "
+                "how well the data pin it, or that they cannot (named undetermined); uses the "
+                "slab tables as --thickness-mm does");
   cmd->add_option("--beam-sigma-mm", args->beam_sigma_mm,
                   "the beam (with the lens) as a round Gaussian of this sigma, mm, for every "
                   "input (default: each input's system response measured by its white reference, "

@@ -182,7 +182,7 @@ std::shared_ptr<const materials::SlabNodes> slab_nodes_for(const std::vector<fit
                                                           std::uint64_t photons, bool quiet) {
   bool slab = false, far = false;
   for (const fit::ProfileData& d : data) {
-    slab = slab || options.thickness_mm || d.thickness_mm;
+    slab = slab || options.thickness_mm || options.fit_thickness || d.thickness_mm;
     far = far || d.transmitted;
   }
   if (!slab || options.fit_ior || options.model == fit::FitModel::kDipole ||

@@ -145,12 +145,12 @@ void run(SimulateArguments& args) {
     o.source = acquire::RadianceSource::kDirectionalDipole;
   else
     throw Error("--source: expected montecarlo, dipole or ddipole, got '" + args.source + "'");
-  if (args.side != "reflected" && args.side != "transmitted")
-    throw Error("--side: expected reflected (the lit side) or transmitted (the far side), got '" +
-                args.side + "'");
+  if (args.side != "reflected" && args.side != "transmitted" && args.side != "both")
+    throw Error("--side: expected reflected (the lit side), transmitted (the far side) or both, "
+                "got '" + args.side + "'");
   o.transport.far_side = args.side == "transmitted";
-  if (o.transport.far_side && !std::isfinite(o.transport.thickness_mm))
-    throw Error("--side transmitted: the far side needs --thickness-mm");
+  if (args.side != "reflected" && !std::isfinite(o.transport.thickness_mm))
+    throw Error("--side " + args.side + ": the far side needs --thickness-mm");
   o.camera.noise = !args.no_noise;
   o.white_reference = !args.no_white;
   o.dark_frame = !args.no_dark;
@@ -161,37 +161,58 @@ void run(SimulateArguments& args) {
 
   ProgressLine line("simulate", "photons", args.quiet || args.json);
   const auto progress = [&](std::uint64_t done, std::uint64_t total) { line.update(done, total); };
-  const acquire::SimulateSummary summary = acquire::run_simulation(o, args.output, progress);
+  // Both sides: one capture folder each, OUTDIR/reflected and OUTDIR/transmitted, from the same
+  // photons (the same seed: the far side's run repeats the lit side's paths and scores the other
+  // surface), committed together.
+  std::vector<std::pair<std::string, acquire::SimulateSummary>> sides;
+  if (args.side == "both") {
+    AtomicOutputDir both(args.output);
+    for (const bool far : {false, true}) {
+      o.transport.far_side = far;
+      const char* name = far ? "transmitted" : "reflected";
+      sides.emplace_back(args.output + "/" + name,
+                         acquire::run_simulation(o, both.temporary() / name, progress));
+    }
+    both.commit();
+  } else {
+    sides.emplace_back(args.output, acquire::run_simulation(o, args.output, progress));
+  }
   line.finish();
   // Said once the options have passed (a refusal stays one line).
   if (!field.why.empty() && !args.quiet && !args.json) std::cerr << field.why << '\n';
 
-  const auto& t = summary.transport;
-  if (args.json) {
-    nlohmann::json j = {{"output", args.output},
-                        {"files", summary.files},
-                        {"wall_seconds", t.wall_seconds},
-                        {"threads", t.threads_used},
-                        {"camera_scale", summary.camera_scale}};
-    for (int c = 0; c < 3; ++c) {
-      j["diffuse_reflectance"].push_back(t.channels[c].diffuse_reflectance.value);
-      j["photons"].push_back(t.channels[c].photons);
+  nlohmann::json all = nlohmann::json::array();
+  for (const auto& [folder, summary] : sides) {
+    const auto& t = summary.transport;
+    if (args.json) {
+      nlohmann::json j = {{"output", folder},
+                          {"side", t.options.far_side ? "transmitted" : "reflected"},
+                          {"files", summary.files},
+                          {"wall_seconds", t.wall_seconds},
+                          {"threads", t.threads_used},
+                          {"camera_scale", summary.camera_scale}};
+      for (int c = 0; c < 3; ++c) {
+        j["diffuse_reflectance"].push_back(t.channels[c].diffuse_reflectance.value);
+        j["photons"].push_back(t.channels[c].photons);
+      }
+      all.push_back(j);
+    } else if (!args.quiet) {
+      std::cout << "simulated " << o.material.name << ": " << t.channels[0].photons
+                << " photons per channel in " << t.wall_seconds << " s on " << t.threads_used
+                << " threads\n";
+      const char* names = "RGB";
+      for (int c = 0; c < 3; ++c) {
+        const auto& ch = t.channels[c];
+        std::cout << "  " << names[c] << ": diffuse reflectance " << ch.diffuse_reflectance.value
+                  << " +- " << ch.diffuse_reflectance.standard_error << ", specular "
+                  << ch.specular_reflectance.value << ", transmitted " << ch.transmittance.value
+                  << ", absorbed " << ch.absorbed.value << '\n';
+      }
+      std::cout << "wrote " << summary.files.size() << " files to " << folder << '\n';
     }
-    std::cout << j.dump(2) << '\n';
-  } else if (!args.quiet) {
-    std::cout << "simulated " << o.material.name << ": " << t.channels[0].photons
-              << " photons per channel in " << t.wall_seconds << " s on " << t.threads_used
-              << " threads\n";
-    const char* names = "RGB";
-    for (int c = 0; c < 3; ++c) {
-      const auto& ch = t.channels[c];
-      std::cout << "  " << names[c] << ": diffuse reflectance " << ch.diffuse_reflectance.value
-                << " +- " << ch.diffuse_reflectance.standard_error << ", specular "
-                << ch.specular_reflectance.value << ", transmitted " << ch.transmittance.value
-                << ", absorbed " << ch.absorbed.value << '\n';
-    }
-    std::cout << "wrote " << summary.files.size() << " files to " << args.output << '\n';
   }
+  // One side: the object as before; both: an array of the two.
+  if (args.json) std::cout << (all.size() == 1 ? all[0] : all).dump(2) << '\n';
 }
 
 }  // namespace
@@ -247,8 +268,9 @@ void register_simulate_command(CLI::App& app) {
       ->check(number_in(1e-3, 1000, "mm"))
       ->capture_default_str();
   cmd->add_option("--side", args->side,
-                  "which side the camera sees: reflected (the lit side) or transmitted (a slab's "
-                  "far side, the camera below; needs --thickness-mm)")
+                  "which side the camera sees: reflected (the lit side), transmitted (a slab's "
+                  "far side, the camera below; needs --thickness-mm) or both (OUTDIR/reflected "
+                  "and OUTDIR/transmitted, one capture each, the same photons)")
       ->capture_default_str();
   cmd->add_option("--incidence-deg", o.transport.incidence_deg,
                   "beam angle from the normal, degrees [0, 90)")

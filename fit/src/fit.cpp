@@ -10,6 +10,7 @@
 
 #include "fit_solve.h"
 #include "fit_start.h"
+#include "fit_thickness.h"
 #include "fit_uncertainty.h"
 #include "lack_of_fit.h"
 #include "system_response.h"
@@ -47,6 +48,7 @@ std::string g_text(double g) {  // 0.917, not std::to_string's 0.917000 cut to 0
 }  // namespace
 
 FitResult fit_profiles(const std::vector<ProfileData>& input, const FitOptions& options) {
+  if (options.fit_thickness) return detail::fit_unknown_thickness(input, options);
   // A slab: the thickness the options give every input, or each input's own.
   std::vector<ProfileData> data = input;
   bool slab = false;

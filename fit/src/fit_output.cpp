@@ -21,6 +21,17 @@ json finite_or_null(double v) {
   return std::isfinite(v) ? json(v) : json(nullptr);
 }
 
+// --fit-thickness: null unless fitted; an open end is null (thickness_mm null: semi-infinite).
+json thickness_json(const FitResult& result) {
+  if (!result.thickness) return nullptr;
+  const ThicknessFit& t = *result.thickness;
+  return {{"thickness_mm", finite_or_null(t.thickness_mm)},
+          {"lower_mm", t.lower_mm > 0 ? json(t.lower_mm) : json(nullptr)},
+          {"upper_mm", finite_or_null(t.upper_mm)},
+          {"determined", t.determined},
+          {"fits", t.fits}};
+}
+
 json model_fit_json(const ModelFit& f) {
   json channels = json::array();
   for (const ChannelFit& c : f.channels) {
@@ -170,6 +181,7 @@ materials::Material fitted_material(const FitResult& result, const std::vector<P
                     {"adequate_model", result.adequate_model},
                     {"fallback_model", result.fallback_model},
                     {"adequacy", adequacy_json(result)},
+                    {"fitted_thickness", thickness_json(result)},
                     {"warnings", result.warnings},
                     {"notes", result.notes}}}};
   return m;
@@ -192,6 +204,7 @@ json fit_report(const FitResult& result, const std::vector<ProfileData>& data,
           {"warnings", result.warnings},
           {"g", result.g},
           {"assumed_thickness_mm", finite_or_null(result.assumed_thickness_mm)},
+          {"fitted_thickness", thickness_json(result)},
           {"g_systematic", g_systematic_json(result)},
           {"adequate_model", result.adequate_model},
           {"fallback_model", result.fallback_model},

@@ -163,6 +163,8 @@ std::vector<BadCase> option_cases() {
       {"profile_range_count_zero", nullptr, pro + "--r-range 0:1:0", "--r-range"},
       {"profile_range_spacing", nullptr, pro + "--r-range 0:1:10:cubic", "--r-range"},
       {"sim_thickness_negative", nullptr, sim + "--thickness-mm -1", "thickness"},
+      {"sim_both_sides_without_thickness", nullptr, sim + "--side both", "--thickness-mm"},
+      {"sim_side_misspelt", nullptr, sim + "--thickness-mm 2 --side bothe", "--side"},
       {"acquire_profile_as_capture", nullptr, "acquire {world}/acq/profile.json -o {dir}/a",
        "profile.json"},
       // the command line itself

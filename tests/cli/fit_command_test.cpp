@@ -2,6 +2,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <tuple>
+#include <array>
 
 #include <nlohmann/json.hpp>
 
@@ -203,7 +206,13 @@ INSTANTIATE_TEST_SUITE_P(
         BadFit{"slab_with_a_dipole", "# thickness_mm=2\n" + good_csv(),
                "fit {IN} --ior 1.5 --model dipole -o {OUT}", "semi-infinite"},
         BadFit{"slab_with_fit_ior", "# thickness_mm=2\n" + good_csv(),
-               "fit {IN} --fit-ior -o {OUT}", "--fit-ior"}),
+               "fit {IN} --fit-ior -o {OUT}", "--fit-ior"},
+        BadFit{"thickness_given_and_fitted", good_csv(),
+               "fit {IN} --ior 1.5 --thickness-mm 2 --fit-thickness -o {OUT}",
+               "--fit-thickness: the thickness is either given"},
+        BadFit{"thickness_fitted_with_a_dipole", good_csv(),
+               "fit {IN} --ior 1.5 --fit-thickness --model dipole -o {OUT}",
+               "--fit-thickness: the diffusion models"}),
     [](const ::testing::TestParamInfo<BadFit>& info) { return std::string(info.param.name); });
 
 }  // namespace
@@ -218,7 +227,8 @@ namespace {
 // on the command line, and the lit side not told (refused, naming a thickness). Slab tables at
 // 10^5 photons per node (built once, ~20 s, cached in the test's folder). Measured: lit side
 // within 0.8% (abs z <= 0.6), far side within 2.4% (z <= 1.1), jointly within 0.7% (z <= 0.6).
-TEST(FitSlab, BothSidesAloneAndJointlyAndWithoutTheThicknessRefused) {
+// Then the thickness fitted (--fit-thickness) untold, jointly, and on a semi-infinite capture.
+TEST(FitSlab, BothSidesAloneAndJointlyAndWithoutTheThicknessRefusedOrFitted) {
   const fs::path dir = scratch_dir("fit-slab");
   ASSERT_EQ(::setenv("LUCENT_CACHE_DIR", (dir / "cache").c_str(), 1), 0);
   const auto q = [](const fs::path& p) { return "\"" + p.string() + "\""; };
@@ -283,7 +293,70 @@ TEST(FitSlab, BothSidesAloneAndJointlyAndWithoutTheThicknessRefused) {
   EXPECT_NE(untold.err.find("thinner than about"), std::string::npos) << untold.err;
   EXPECT_NE(untold.err.find("--thickness-mm"), std::string::npos) << untold.err;
   EXPECT_FALSE(fs::exists(dir / "untold.json"));
+
+  // --fit-thickness: the untold lit side, and both sides, pin the 2 mm (measured 1.91 mm, 1 SD
+  // 1.62..2.42, and 2.006 mm, 1.95..2.06); a semi-infinite capture of the same skin is named
+  // undetermined, with the thinnest slab it allows (measured 7.0 mm). Each within the truth's 3 SD.
+  const auto fitted = [&](const std::string& inputs, const char* out) {
+    const nlohmann::json m = fit(inputs, "--fit-thickness", out);
+    for (int c = 0; c < 3 && m.contains("sigma_a"); ++c)
+      for (const char* key : {"sigma_a", "sigma_s_reduced"}) {
+        const double t = truth[key][c], v = m[key][c], sd = m["uncertainty"][key][c];
+        EXPECT_LT(std::abs(v - t), 3 * sd) << out << " " << key << "[" << c << "]";
+      }
+    return m.contains("provenance") ? m["provenance"]["fit"]["fitted_thickness"] : nlohmann::json();
+  };
+  for (const auto& [inputs, out, tolerance] :
+       {std::tuple{q(dir / "untold.csv"), "fit-untold.json", 0.1},
+        std::tuple{lit + " " + far, "fit-joint.json", 0.03}}) {
+    const nlohmann::json t = fitted(inputs, out);
+    ASSERT_TRUE(t.is_object()) << out;
+    EXPECT_TRUE(t["determined"].get<bool>()) << t.dump();
+    EXPECT_NEAR(t["thickness_mm"].get<double>(), 2.0, 2.0 * tolerance) << t.dump();
+    // The truth within 3 SD of the interval (1 SD each side).
+    const double d = t["thickness_mm"], lower = t["lower_mm"], upper = t["upper_mm"];
+    EXPECT_LT(lower, d);
+    EXPECT_GT(upper, d);
+    EXPECT_GT(2.0, d - 3 * (d - lower)) << t.dump();
+    EXPECT_LT(2.0, d + 3 * (upper - d)) << t.dump();
+  }
+  ASSERT_EQ(run_lucent("simulate --material skin1 -o " + q(dir / "semi") +
+                       " --photons 1000000 --size 96 --pixel-mm 0.25 --seed 3 -q")
+                .exit_code,
+            0);
+  ASSERT_EQ(run_lucent("acquire " + q(dir / "semi" / "capture.json") + " -q -o " +
+                       q(dir / "semi-acq"))
+                .exit_code,
+            0);
+  const nlohmann::json semi = fitted(q(dir / "semi-acq" / "profile.json"), "fit-semi.json");
+  ASSERT_TRUE(semi.is_object());
+  EXPECT_FALSE(semi["determined"].get<bool>()) << semi.dump();
+  EXPECT_TRUE(semi["thickness_mm"].is_null()) << semi.dump();
+  EXPECT_GT(semi["lower_mm"].get<double>(), 3.0) << semi.dump();
   ::unsetenv("LUCENT_CACHE_DIR");
+  fs::remove_all(dir);
+}
+
+// simulate --side both: one capture folder per side from the same photons (the same seed), so the
+// two truth files' totals (reflected, transmitted) agree exactly while each records its side.
+TEST(SimulateBothSides, TwoCapturesOfOnePhotonRun) {
+  const fs::path dir = scratch_dir("sim-both");
+  const auto q = [](const fs::path& p) { return "\"" + p.string() + "\""; };
+  const auto r = run_lucent("simulate --material skin1 --thickness-mm 2 --side both --photons "
+                            "20000 --size 32 --pixel-mm 0.25 -q -o " + q(dir / "b"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::array<nlohmann::json, 2> truth;
+  for (int i = 0; i < 2; ++i) {
+    const char* side = i ? "transmitted" : "reflected";
+    const nlohmann::json cap = nlohmann::json::parse(read_text(dir / "b" / side / "capture.json"));
+    EXPECT_EQ(cap["side"], side);
+    EXPECT_DOUBLE_EQ(cap["thickness_mm"].get<double>(), 2.0);
+    truth[i] = nlohmann::json::parse(read_text(dir / "b" / side / "truth.json"));
+    EXPECT_EQ(truth[i]["transport"]["side"], side);
+  }
+  for (int c = 0; c < 3; ++c)
+    for (const char* key : {"diffuse_reflectance", "transmittance"})
+      EXPECT_EQ(truth[0]["totals"][key][c], truth[1]["totals"][key][c]) << key << c;
   fs::remove_all(dir);
 }
 

@@ -45,6 +45,9 @@ struct FitOptions {
   /// The sample is a slab this thick (mm), for every input (over what the inputs say); absent:
   /// what each input says (thickness_mm, side), else semi-infinite.
   std::optional<double> thickness_mm;
+  /// The sample is a slab of unknown thickness, fitted (one for every input; the lit side's
+  /// tables needed, as for thickness_mm): FitResult::thickness says how well the data pin it.
+  bool fit_thickness = false;
   /// A slab's tables at the data's (eta, g) (lucent fit builds them: cli/fit_tables.h); needed
   /// when any input is a slab. The lit side's nodes without the semi-infinite one (the fit adds
   /// its own table's).
@@ -163,6 +166,17 @@ struct ModelAdequacy {
   bool adequate = false;     ///< within tolerance beyond a radius inside the data
 };
 
+/// A fitted slab thickness (FitOptions::fit_thickness), mm.
+struct ThicknessFit {
+  /// The best fit; infinity when the data fit a semi-infinite sample as well as any thick slab.
+  double thickness_mm = 0;
+  /// The 1 SD interval (chi^2 within max(1, reduced chi^2) of its minimum); lower 0 or upper
+  /// infinity where it is open (the data allow any thinner or thicker slab).
+  double lower_mm = 0, upper_mm = 0;
+  bool determined = false;  ///< both ends closed
+  int fits = 0;             ///< coefficient fits the search took
+};
+
 struct FitResult {
   ModelFit chosen;
   std::vector<ModelFit> candidates;     ///< every model fitted (auto: accurate first)
@@ -179,6 +193,8 @@ struct FitResult {
   double g = 0;                         ///< the g the tabulated model assumed
   /// A semi-infinite fit: the thinnest sample for which that answer holds (mm; 0 for a slab fit).
   double assumed_thickness_mm = 0;
+  /// --fit-thickness: the thickness found.
+  std::optional<ThicknessFit> thickness;
   /// Per channel {sigma_a, sigma_s'} of the tabulated fit at g = g_other (0.9, or 0 when the fit
   /// assumed g >= 0.45): how far the answer moves with the assumed g. Empty when not computed.
   std::vector<std::array<double, 2>> g_09;
