@@ -12,6 +12,7 @@
 #include "lucent/materials/error.h"
 #include "lucent/materials/json_file.h"
 #include "lucent/materials/transport_table.h"
+#include "fit_beam.h"
 #include "fit_tables.h"
 #include "progress.h"
 #include "validators.h"
@@ -40,6 +41,8 @@ struct FitArguments {
   std::uint64_t slab_photons = 200'000;
   double thickness_mm = 0;  // 0: not given
   double beam_sigma_mm = 0;  // 0: not given
+  std::string beam_image;
+  double beam_pixel_mm = 0;  // 0: the first input's pixel pitch
   bool fit_ior = false, relative = false, json = false, allow_unconverged = false;
   bool fit_thickness = false;
   bool plot_log_r = false;  // --plot-log-r
@@ -123,6 +126,11 @@ materials::Material run(const FitArguments& a) {
                   ", which carries no index (no ior= or eta= "
                   "in its comment lines)");
     }
+  }
+  if (!a.beam_image.empty()) {
+    if (a.beam_sigma_mm > 0)
+      throw Error("--beam-image: the beam is given either as an image or as --beam-sigma-mm");
+    use_beam_image(data, a.beam_image, a.beam_pixel_mm);
   }
   materials::TransportTable table;
   if (!a.table.empty()) {
@@ -342,6 +350,14 @@ void register_fit_command(CLI::App& app) {
                 "the sample is a slab of unknown thickness: fit it (one for every input) and say "
                 "how well the data pin it, or that they cannot (named undetermined); uses the "
                 "slab tables as --thickness-mm does");
+  cmd->add_option("--beam-image", args->beam_image,
+                  "the beam as an image of its spot on a flat white target through the same lens "
+                  "(OpenEXR, linear, dark frame taken off; or PNG/TIFF codes taken as linear), for "
+                  "captures without a white reference: every input's model is convolved with its "
+                  "radial profile (over the inputs' own response)");
+  cmd->add_option("--beam-pixel-mm", args->beam_pixel_mm,
+                  "the beam image's pixel pitch on the target, mm (default: the first input's)")
+      ->check(number_in(1e-4, 100, "mm"));
   cmd->add_option("--beam-sigma-mm", args->beam_sigma_mm,
                   "the beam (with the lens) as a round Gaussian of this sigma, mm, for every "
                   "input (default: each input's system response measured by its white reference, "

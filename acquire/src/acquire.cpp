@@ -103,20 +103,12 @@ BeamPower white_reference_power(const HdrResult& white, double reflectance, doub
   return result;
 }
 
-// The system response the white reference records: its light, averaged over the channels, in rings
-// of half a pixel about its centroid, normalised to unit integral (per mm^2); and its rms radius.
-// Rings run to the nearest image edge. The border's level is not taken off (unlike for the beam
-// power): far from the spot it is the lens's veiling glare, which the response must keep (a dark
-// frame taken with the beam off carries the room's light).
-struct SystemResponse {
-  std::vector<double> r_mm, value;
-  double rms_mm = 0;
-};
+// The system response the white reference records: its light, averaged over the channels
+// (beam.h, system_response).
 SystemResponse white_reference_response(const HdrResult& white, const BeamPower& power,
                                         double pixel_mm) {
   const int w = white.width(), h = white.height();
   std::vector<double> v(std::size_t(w) * h, 0.0);
-  double total = 0, cx = 0, cy = 0, peak = 0;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       double sum = 0;
@@ -124,44 +116,8 @@ SystemResponse white_reference_response(const HdrResult& white, const BeamPower&
         if (white.mask_at(x, y, c) != PixelMask::kNonFinite)
           sum += white.radiance.at(x, y, c) / power.power[c];
       v[std::size_t(y) * w + x] = sum / 3;
-      peak = std::max(peak, sum / 3);
     }
-  // The centroid of the spot (pixels above a tenth of the peak: the noise far out would pull it).
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const double s = v[std::size_t(y) * w + x];
-      if (s > 0.1 * peak) total += s, cx += s * (x + 0.5), cy += s * (y + 0.5);
-    }
-  SystemResponse r;
-  if (!(total > 0)) return r;
-  cx /= total, cy /= total;
-  const double reach = std::min({cx, cy, w - cx, h - cy});
-  const int rings = std::max(1, int(2 * reach));
-  std::vector<double> sum(std::size_t(rings), 0.0), sum2(std::size_t(rings), 0.0),
-      count(std::size_t(rings), 0.0);
-  double all = 0, second = 0;
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const double d = std::hypot(x + 0.5 - cx, y + 0.5 - cy), s = v[std::size_t(y) * w + x];
-      all += s, second += s * d * d;
-      const int k = int(2 * d);
-      if (k < rings) sum[std::size_t(k)] += s, sum2[std::size_t(k)] += s * s, count[std::size_t(k)] += 1;
-    }
-  if (!(all > 0)) return r;
-  const double area = pixel_mm * pixel_mm;
-  for (int k = 0; k < rings; ++k) {
-    const double n = count[std::size_t(k)];
-    if (n == 0) continue;
-    const double mean = sum[std::size_t(k)] / n;
-    const double se = n > 1 ? std::sqrt(std::max(0.0, sum2[std::size_t(k)] / n - mean * mean) / (n - 1))
-                            : INFINITY;
-    r.r_mm.push_back((k + 0.5) * 0.5 * pixel_mm);
-    // A ring no brighter than 3 of its standard errors is the dark field's noise, not light: 0
-    // (the profile spans six decades; a floor of noise would be a veil over its tail).
-    r.value.push_back(mean > 3 * se ? mean / (all * area) : 0.0);
-  }
-  r.rms_mm = std::sqrt(std::max(0.0, second / all)) * pixel_mm;
-  return r;
+  return system_response(v, w, h, pixel_mm);
 }
 
 // The picture for a person: log tone mapping between the 1st and 99.9th percentile luminance, sRGB,

@@ -123,7 +123,7 @@ std::string attach_system_response(Observations& o, const ProfileData& d, double
   if (gaussian)
     what << "a Gaussian beam of sigma " << beam_sigma_mm << " mm (--beam-sigma-mm)";
   else
-    what << "the system response the white reference recorded (rms radius " << d.response_rms_mm
+    what << "the system response " << d.response_source << " (rms radius " << d.response_rms_mm
          << " mm over the whole field)";
   return what.str();
 }

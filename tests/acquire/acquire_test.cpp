@@ -2,6 +2,9 @@
 // merge, beam detection, radial binning and 2D samples, on the synthetic captures of
 // acquire_fixtures.h.
 #include "acquire_fixtures.h"
+#include "lucent/acquire/beam.h"
+
+#include <numbers>
 
 namespace lucent::acquire {
 namespace {
@@ -414,3 +417,41 @@ TEST(RadialBinning, SamplesWithinRadius) {
 
 }  // namespace
 }  // namespace lucent::acquire
+
+namespace lucent::testing {
+namespace {
+
+// The system response from an image of a spot (the white reference's, or --beam-image): a round
+// Gaussian of sigma 0.5 mm on 0.1 mm pixels comes back as that Gaussian (unit integral, per mm^2)
+// and its rms radius sqrt(2) sigma; an image without light gives nothing.
+TEST(SystemResponseImage, AGaussianSpotIsItsOwnResponse) {
+  const int n = 121;
+  const double pixel = 0.1, sigma = 0.5, c = 60.5;  // the spot's centre, pixels
+  std::vector<double> light(std::size_t(n) * n);
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const double r2 = (std::pow(x + 0.5 - c, 2) + std::pow(y + 0.5 - c, 2)) * pixel * pixel;
+      light[std::size_t(y) * n + x] = 7.0 * std::exp(-r2 / (2 * sigma * sigma));
+    }
+  const acquire::SystemResponse r = acquire::system_response(light, n, n, pixel);
+  ASSERT_GT(r.r_mm.size(), 100u);
+  double worst = 0;
+  for (std::size_t i = 0; i < r.r_mm.size(); ++i) {
+    const double want = std::exp(-r.r_mm[i] * r.r_mm[i] / (2 * sigma * sigma)) /
+                        (2 * std::numbers::pi * sigma * sigma);
+    if (r.r_mm[i] > 3 * sigma) break;
+    // Rings of half a pixel average the pixels whose centres fall in them: the ring's radius is
+    // its middle, good to ~ (pixel / sigma)^2 / 8 near the centre; 3% allowed.
+    worst = std::max(worst, std::abs(r.value[i] / want - 1));
+  }
+  EXPECT_LT(worst, 0.03);
+  EXPECT_NEAR(r.rms_mm, std::sqrt(2.0) * sigma, 0.01);
+  std::fill(light.begin(), light.end(), 0.0);
+  EXPECT_TRUE(acquire::system_response(light, n, n, pixel).r_mm.empty());
+  std::fill(light.begin(), light.end(), -1.0);
+  EXPECT_TRUE(acquire::system_response(light, n, n, pixel).r_mm.empty());
+}
+
+}  // namespace
+}  // namespace lucent::testing
+

@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "lucent/acquire/hdr_merge.h"
 
@@ -45,5 +46,20 @@ struct BeamPoint {
 /// found: ..." when the peak does not stand out of the background.
 BeamPoint find_beam_point(const HdrResult& hdr, const std::string& source,
                           const BeamDetectionOptions& options = {});
+
+/// A bench's system response (beam footprint (x) lens blur (x) glare (x) pixel), as its light on a
+/// flat white target records it: radial rings of half a pixel about the spot's centroid (the
+/// pixels above a tenth of the peak), normalised to unit integral, per mm^2, out to the nearest
+/// image edge; a ring no brighter than 3 of its standard errors is 0 (the dark field's noise, not
+/// light). No level is taken off: far from the spot it is the lens's veiling glare.
+struct SystemResponse {
+  std::vector<double> r_mm, value;
+  double rms_mm = 0;  ///< rms radius of all the light about the centroid, mm
+};
+
+/// The response from an image's light, row-major width x height (NaN: left out), pixels of
+/// pixel_mm on the target. Empty when there is no light (every pixel 0 or below).
+SystemResponse system_response(const std::vector<double>& light, int width, int height,
+                               double pixel_mm);
 
 }  // namespace lucent::acquire

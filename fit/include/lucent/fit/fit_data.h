@@ -60,6 +60,8 @@ struct ProfileData {
   /// pixel): radial, per mm^2, unit integral; and its rms radius, mm. Empty when not measured.
   std::vector<double> response_r_mm, response_value;
   double response_rms_mm = 0;
+  /// Who recorded it, for the report ("the white reference recorded", "the beam image X recorded").
+  std::string response_source = "the white reference recorded";
   RadialBins radial;
   std::optional<Samples2d> samples_2d;
   std::array<bool, 3> channels{true, true, true};  ///< which channels carry data
