@@ -82,6 +82,12 @@ FitResult fit_profiles(const std::vector<ProfileData>& input, const FitOptions& 
     if (options.progress) options.progress(stage, done);
   };
   if (data.empty()) throw Error("fit: no input profile");
+  // A real beam on 2D samples, which the model cannot hold (system_response.h): said before the
+  // (long) 2D solve; with --allow-unconverged the fit goes on and is marked not converged.
+  for (const ProfileData& d : data)
+    if (detail::response_not_convolved(d, options.beam_sigma_mm) && !options.allow_unconverged)
+      throw Error(detail::describe_system_response(d, options.beam_sigma_mm) +
+                  " (or --allow-unconverged to fit it as a pencil beam)");
   for (const ProfileData& d : data) {
     if (d.radial.size() == 0 && !(d.samples_2d && d.samples_2d->size() > 0)) {
       throw Error(d.source + ": the profile is empty (no radial bins, no 2D samples)");
@@ -554,16 +560,9 @@ FitResult fit_profiles(const std::vector<ProfileData>& input, const FitOptions& 
       // A table without that g: nothing to say.
     }
   }
-  // Which inputs' model was convolved with a system response, and with what.
-  for (const ProfileData& d : data) {
-    detail::Observations probe;
-    probe.r = {1.0};
-    const std::string what = detail::attach_system_response(probe, d, options.beam_sigma_mm);
-    result.notes.push_back(d.source + ": " +
-                           (what.empty() ? std::string("a pencil beam and a sharp lens assumed (no "
-                                                       "system response wider than the pixels)")
-                                         : "the model is convolved with " + what));
-  }
+  // What each input's system response did (convolved, or its 2D near field left out).
+  for (const ProfileData& d : data)
+    result.notes.push_back(detail::describe_system_response(d, options.beam_sigma_mm));
   // A semi-infinite answer holds for samples thick enough: the thinnest slab whose profile stays
   // within 10% of it over the data (diffusion theory). A slab thinner than that but thick enough
   // to leave no structure the fit can see would pass for a semi-infinite sample of higher sigma_a
@@ -612,6 +611,12 @@ FitResult fit_profiles(const std::vector<ProfileData>& input, const FitOptions& 
       result.notes.push_back("the data cannot determine " + u + " (left out of the uncertainty)");
     }
   }
+  // A real beam on 2D samples: the model cannot hold it (system_response.h).
+  for (const ProfileData& d : data)
+    if (detail::response_not_convolved(d, options.beam_sigma_mm)) {
+      result.chosen.converged = false;
+      result.chosen.message = detail::describe_system_response(d, options.beam_sigma_mm);
+    }
   if (!result.chosen.converged && !options.allow_unconverged) {
     std::ostringstream s;
     s.precision(6);

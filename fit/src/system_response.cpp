@@ -26,10 +26,14 @@ double bessel_i0e(double x) {
          std::sqrt(x);
 }
 
-bool response_is_wide(const ProfileData& d) {
+namespace {
+
+// The rms radius of the response's core (the rings above 1e-4 of its peak), mm, and the share of
+// its light beyond 3 pixels; {0, 0} without a response.
+std::pair<double, double> core_and_glare(const ProfileData& d) {
   const std::vector<double>& r = d.response_r_mm;
   const std::vector<double>& v = d.response_value;
-  if (r.size() < 2 || r.size() != v.size()) return false;
+  if (r.size() < 2 || r.size() != v.size()) return {0.0, 0.0};
   const double pixel = d.radial.pixel_mm;
   // The rings as annuli about their radii (rings of equal width), down to where the response
   // falls below 1e-4 of its peak: the noise of the white reference's dark field must not pass for
@@ -42,11 +46,24 @@ bool response_is_wide(const ProfileData& d) {
     if (v[i] >= 1e-4 * peak) energy += ring, second += ring * r[i] * r[i];
     if (pixel > 0 && r[i] > 3 * pixel) outside += ring;  // glare, whatever its level
   }
-  if (!(energy > 0)) return false;
-  const double rms = std::sqrt(second / energy);
+  if (!(energy > 0)) return {0.0, 0.0};
+  return {std::sqrt(second / energy), outside};
+}
+
+}  // namespace
+
+bool response_is_wide(const ProfileData& d) {
+  const auto [rms, outside] = core_and_glare(d);
+  if (!(rms > 0)) return false;
+  const double pixel = d.radial.pixel_mm;
   // Wider than the pixels' own footprint (a pencil beam through a sharp lens gives a spot of about
   // one pixel sigma: rms 1.4-1.5 pixels, 1.1% of it beyond 3 pixels), or a glare veil of 2% or more.
   return pixel > 0 ? rms > 2 * pixel || outside > 0.02 : rms > 0;
+}
+
+bool response_not_convolved(const ProfileData& d, double beam_sigma_mm) {
+  const bool two_d = d.samples_2d.has_value() && d.incidence_polar_deg > 0;
+  return two_d && (beam_sigma_mm > 0 || response_is_wide(d));
 }
 
 std::string attach_system_response(Observations& o, const ProfileData& d, double beam_sigma_mm) {
@@ -126,6 +143,26 @@ std::string attach_system_response(Observations& o, const ProfileData& d, double
     what << "the system response " << d.response_source << " (rms radius " << d.response_rms_mm
          << " mm over the whole field)";
   return what.str();
+}
+
+std::string describe_system_response(const ProfileData& d, double beam_sigma_mm) {
+  const bool two_d = d.samples_2d.has_value() && d.incidence_polar_deg > 0;
+  std::ostringstream s;
+  s.precision(3);
+  s << d.source << ": ";
+  if (response_not_convolved(d, beam_sigma_mm))
+    return s.str() + "its 2D samples carry a system response wider than the pixels (" +
+           (beam_sigma_mm > 0 ? "--beam-sigma-mm" : "the white reference's") +
+           ") that the fit cannot convolve (radial fits only): fit the radial profile of a "
+           "capture at normal incidence";
+  if (!two_d) {
+    Observations probe;
+    probe.r = {1.0};
+    const std::string what = attach_system_response(probe, d, beam_sigma_mm);
+    if (!what.empty()) return s.str() + "the model is convolved with " + what;
+  }
+  return s.str() +
+         "a pencil beam and a sharp lens assumed (no system response wider than the pixels)";
 }
 
 }  // namespace lucent::fit::detail
