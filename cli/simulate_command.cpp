@@ -2,7 +2,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
+#include <optional>
 #include <memory>
 #include <sstream>
 
@@ -167,9 +169,15 @@ void run(SimulateArguments& args) {
   std::vector<std::pair<std::string, acquire::SimulateSummary>> sides;
   if (args.side == "both") {
     AtomicOutputDir both(args.output);
+    const std::optional<std::string> csv = o.exitance_csv;
     for (const bool far : {false, true}) {
       o.transport.far_side = far;
       const char* name = far ? "transmitted" : "reflected";
+      // Each side's radial table in its own file: FILE-reflected.csv, FILE-transmitted.csv.
+      if (csv) {
+        const std::filesystem::path p(*csv);
+        o.exitance_csv = (p.parent_path() / (p.stem().string() + "-" + name + p.extension().string())).string();
+      }
       sides.emplace_back(args.output + "/" + name,
                          acquire::run_simulation(o, both.temporary() / name, progress));
     }
@@ -330,7 +338,8 @@ void register_simulate_command(CLI::App& app) {
   cmd->add_flag("--no-dark", args->no_dark, "do not take a dark frame");
   cmd->add_flag("--profile-only", o.profile_only, "transport only: no images, no capture.json");
   cmd->add_option("--exitance-csv", args->exitance_csv,
-                  "also write the radial exitance R(r) (mm^-2 per unit power) and totals as CSV");
+                  "also write the radial exitance R(r) (mm^-2 per unit power) and totals as CSV "
+                  "(--side both: FILE-reflected.csv and FILE-transmitted.csv)");
   cmd->add_flag("--json", args->json, "print a JSON summary on stdout");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress or summary");
   cmd->callback([args, size, pixel] {

@@ -82,12 +82,6 @@ FitResult fit_profiles(const std::vector<ProfileData>& input, const FitOptions& 
     if (options.progress) options.progress(stage, done);
   };
   if (data.empty()) throw Error("fit: no input profile");
-  // A real beam on 2D samples, which the model cannot hold (system_response.h): said before the
-  // (long) 2D solve; with --allow-unconverged the fit goes on and is marked not converged.
-  for (const ProfileData& d : data)
-    if (detail::response_not_convolved(d, options.beam_sigma_mm) && !options.allow_unconverged)
-      throw Error(detail::describe_system_response(d, options.beam_sigma_mm) +
-                  " (or --allow-unconverged to fit it as a pencil beam)");
   for (const ProfileData& d : data) {
     if (d.radial.size() == 0 && !(d.samples_2d && d.samples_2d->size() > 0)) {
       throw Error(d.source + ": the profile is empty (no radial bins, no 2D samples)");
@@ -611,12 +605,6 @@ FitResult fit_profiles(const std::vector<ProfileData>& input, const FitOptions& 
       result.notes.push_back("the data cannot determine " + u + " (left out of the uncertainty)");
     }
   }
-  // A real beam on 2D samples: the model cannot hold it (system_response.h).
-  for (const ProfileData& d : data)
-    if (detail::response_not_convolved(d, options.beam_sigma_mm)) {
-      result.chosen.converged = false;
-      result.chosen.message = detail::describe_system_response(d, options.beam_sigma_mm);
-    }
   if (!result.chosen.converged && !options.allow_unconverged) {
     std::ostringstream s;
     s.precision(6);

@@ -7,11 +7,13 @@
 
 #include <algorithm>
 #include <array>
+#include <memory>
 #include <cmath>
 #include <numbers>
 #include <optional>
 #include <vector>
 
+#include "convolution_2d.h"
 #include "dipole_gradient.h"
 #include "fit_solve.h"
 #include "lucent/fit/fit.h"
@@ -59,6 +61,9 @@ struct Observations {
   // The response's value (per mm^2) at each sample: what the once-scattered point at the entry
   // becomes (single_scattering_point).
   std::vector<double> conv_point;
+  // 2D samples with a system response (convolution_2d.h): the model on a grid of cells,
+  // convolved, read at each sample; null: none.
+  std::shared_ptr<const Convolution2d> conv2d;
   int capture = 0;  // index of the profile these come from
 };
 
@@ -119,6 +124,23 @@ struct ProfileResiduals {
           materials::Medium<T>{medium.sigma_a, medium.sigma_s / T(1 - g), T(g), eta},
           obs->geometry);
     }
+    // The model at one 2D point over a footprint of side `pixel`.
+    const auto pixel_value = [&](double x, double y, double pixel) -> T {
+      return ob ? detail::oblique_pixel(*ob, q, obs->geometry, x, y, pixel, gl)
+             : tab ? (oblique ? detail::corrected_ddipole_pixel(*tab, *dd, q, obs->geometry, x, y,
+                                                                pixel, gl)
+                              : detail::tabulated_pixel(*tab, q, x, y, pixel, gl))
+                   : detail::model_value(model, table, medium, obs->geometry, false, 0.0, 0.0,
+                                         0.0, x, y, pixel, gl);
+    };
+    std::vector<T> grid;
+    if (const Convolution2d* c2 = obs->conv2d.get()) {
+      grid.resize(std::size_t(c2->nx) * std::size_t(c2->ny));
+      for (int yj = 0; yj < c2->ny; ++yj)
+        for (int xi = 0; xi < c2->nx; ++xi)
+          grid[std::size_t(yj) * c2->nx + xi] = pixel_value(c2->cell_x(xi), c2->cell_y(yj), c2->h);
+      convolve(*c2, grid);
+    }
     for (std::size_t i = 0; i < n; ++i) {
       T convolved(0);
       if (m > 0) {
@@ -127,16 +149,19 @@ struct ProfileResiduals {
           if (w[j] != 0) convolved += w[j] * at_nodes[j];
         convolved += point * obs->conv_point[i];
       }
-      const T v = m > 0 ? convolved :
-          ob ? detail::oblique_pixel(*ob, q, obs->geometry, obs->x[i], obs->y[i], obs->pixel, gl)
-          : tab ? (obs->radial  ? detail::tabulated_annulus(*tab, q, obs->r[i], obs->r0[i], obs->r1[i], gl)
-                 : oblique ? detail::corrected_ddipole_pixel(*tab, *dd, q, obs->geometry, obs->x[i],
-                                                             obs->y[i], obs->pixel, gl)
-                           : detail::tabulated_pixel(*tab, q, obs->x[i], obs->y[i], obs->pixel, gl))
-              : detail::model_value(model, table, medium, obs->geometry, obs->radial,
-                                    obs->radial ? obs->r[i] : 0.0, obs->radial ? obs->r0[i] : 0.0,
-                                    obs->radial ? obs->r1[i] : 0.0, obs->x[i], obs->y[i],
-                                    obs->pixel, gl);
+      T v(0);
+      if (const Convolution2d* c2 = obs->conv2d.get()) {
+        for (std::size_t k = 0; k < 4; ++k)
+          if (c2->weights[i][k] != 0) v += c2->weights[i][k] * grid[std::size_t(c2->cells[i][k])];
+      } else if (m > 0) {
+        v = convolved;
+      } else if (!obs->radial) {
+        v = pixel_value(obs->x[i], obs->y[i], obs->pixel);
+      } else {
+        v = tab ? detail::tabulated_annulus(*tab, q, obs->r[i], obs->r0[i], obs->r1[i], gl)
+                : detail::model_value(model, table, medium, obs->geometry, true, obs->r[i],
+                                      obs->r0[i], obs->r1[i], obs->x[i], obs->y[i], obs->pixel, gl);
+      }
       T scaled = v;
       if (perturbation.epsilon != 0) {
         const double r = obs->radial ? obs->r[i] : std::hypot(obs->x[i], obs->y[i]);

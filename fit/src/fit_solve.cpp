@@ -219,7 +219,11 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
         problem.AddResidualBlock(cost, nullptr, p.ab[c].data(), scale, &p.eta);
         record(c, &o, int(o.log_value.size()));
       } else {
-        // A robust loss acts on each sample, so each gets its own block.
+        // A robust loss acts on each sample, so each gets its own block: a 2D convolution (the
+        // whole grid per evaluation) cannot be split so.
+        if (o.conv2d)
+          throw Error("--loss: a robust loss cannot go with 2D samples convolved with a system "
+                      "response (" + d.source + "); use --loss none");
         for (std::size_t i = 0; i < o.log_value.size(); ++i) {
           p.observations.push_back(o);
           Observations& one = p.observations.back();

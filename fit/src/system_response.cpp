@@ -61,15 +61,44 @@ bool response_is_wide(const ProfileData& d) {
   return pixel > 0 ? rms > 2 * pixel || outside > 0.02 : rms > 0;
 }
 
-bool response_not_convolved(const ProfileData& d, double beam_sigma_mm) {
-  const bool two_d = d.samples_2d.has_value() && d.incidence_polar_deg > 0;
-  return two_d && (beam_sigma_mm > 0 || response_is_wide(d));
+// 2D samples: the grid convolution (convolution_2d.h) with a Gaussian of beam_sigma_mm (the
+// cells' own footprint is in the model), or the measured response where it is wide.
+static std::string attach_2d(Observations& o, const ProfileData& d, double beam_sigma_mm) {
+  const bool gaussian = beam_sigma_mm > 0;
+  if (!gaussian && !response_is_wide(d)) return "";
+  const std::vector<double>& kr = d.response_r_mm;
+  const std::vector<double>& kv = d.response_value;
+  const auto density = [&](double x) {
+    if (gaussian)
+      return std::exp(-x * x / (2 * beam_sigma_mm * beam_sigma_mm)) /
+             (2 * std::numbers::pi * beam_sigma_mm * beam_sigma_mm);
+    if (x <= kr.front()) return std::max(0.0, kv.front());
+    if (x >= kr.back()) return 0.0;
+    const auto hi = std::size_t(std::upper_bound(kr.begin(), kr.end(), x) - kr.begin());
+    const double t = (x - kr[hi - 1]) / (kr[hi] - kr[hi - 1]);
+    return std::max(0.0, kv[hi - 1] + t * (kv[hi] - kv[hi - 1]));
+  };
+  o.conv2d = make_convolution_2d(o.x, o.y, o.pixel, density,
+                                 gaussian ? 6 * beam_sigma_mm : kr.back());
+  std::ostringstream what;
+  what.precision(3);
+  if (gaussian)
+    what << "a Gaussian beam of sigma " << beam_sigma_mm << " mm (--beam-sigma-mm)";
+  else
+    what << "the system response " << d.response_source << " (rms radius " << d.response_rms_mm
+         << " mm over the whole field)";
+  what << " (2D samples: on a grid of cells, by FFT)";
+  return what.str();
 }
+
+
 
 std::string attach_system_response(Observations& o, const ProfileData& d, double beam_sigma_mm) {
   o.conv_nodes.clear();
   o.conv_weights.clear();
   o.conv_point.clear();
+  o.conv2d.reset();
+  if (o.r.empty() && !o.x.empty() && o.linear) return attach_2d(o, d, beam_sigma_mm);
   if (o.linear || o.r.empty()) return "";
   const double pixel = d.radial.pixel_mm;
   const bool gaussian = beam_sigma_mm > 0;
@@ -146,23 +175,17 @@ std::string attach_system_response(Observations& o, const ProfileData& d, double
 }
 
 std::string describe_system_response(const ProfileData& d, double beam_sigma_mm) {
-  const bool two_d = d.samples_2d.has_value() && d.incidence_polar_deg > 0;
-  std::ostringstream s;
-  s.precision(3);
-  s << d.source << ": ";
-  if (response_not_convolved(d, beam_sigma_mm))
-    return s.str() + "its 2D samples carry a system response wider than the pixels (" +
-           (beam_sigma_mm > 0 ? "--beam-sigma-mm" : "the white reference's") +
-           ") that the fit cannot convolve (radial fits only): fit the radial profile of a "
-           "capture at normal incidence";
-  if (!two_d) {
-    Observations probe;
+  Observations probe;
+  if (d.samples_2d.has_value() && d.incidence_polar_deg > 0) {  // 2D samples
+    probe.x = {1.0}, probe.y = {0.0}, probe.linear = true, probe.pixel = d.samples_2d->pixel_mm;
+  } else {
     probe.r = {1.0};
-    const std::string what = attach_system_response(probe, d, beam_sigma_mm);
-    if (!what.empty()) return s.str() + "the model is convolved with " + what;
   }
-  return s.str() +
-         "a pencil beam and a sharp lens assumed (no system response wider than the pixels)";
+  const std::string what = attach_system_response(probe, d, beam_sigma_mm);
+  return d.source + ": " +
+         (what.empty() ? "a pencil beam and a sharp lens assumed (no system response wider than "
+                         "the pixels)"
+                       : "the model is convolved with " + what);
 }
 
 }  // namespace lucent::fit::detail

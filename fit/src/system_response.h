@@ -24,21 +24,14 @@ double bessel_i0e(double x);
 /// rings above 1e-4 of the peak) above 2 pixels, or 2% of it beyond 3 pixels (glare).
 bool response_is_wide(const ProfileData& d);
 
-/// Fills o.conv_nodes and o.conv_weights for radial bins (o.r) when a response applies: a
-/// Gaussian of beam_sigma_mm (> 0; with the pixel's own spread added for pixel bins), else the
-/// data's measured response when response_is_wide. Returns what was applied, for the report (""
-/// when nothing).
+/// Fills o.conv_nodes and o.conv_weights for radial bins (o.r), or o.conv2d for 2D samples
+/// (convolution_2d.h), when a response applies: a Gaussian of beam_sigma_mm (> 0; with the pixel's
+/// own spread added for pixel bins), else the data's measured response when response_is_wide.
+/// Returns what was applied, for the report ("" when nothing).
 std::string attach_system_response(Observations& o, const ProfileData& d, double beam_sigma_mm);
 
-/// Whether a response applies to these data that the fit cannot convolve: 2D samples (the
-/// convolution above is radial; a 2D one costs the model at every kernel tap of every pixel) with
-/// --beam-sigma-mm or a wide measured response. Such a fit is refused (not converged): a skin1
-/// capture at 45 degrees with a 0.5 mm beam was fitted 6-33% off (|z| up to 11) with exit 0, and
-/// leaving out 3 sigma of the near field did not help.
-bool response_not_convolved(const ProfileData& d, double beam_sigma_mm);
-
-/// What the fit did about an input's system response, for the report: convolved with what (radial
-/// bins), not convolved (2D samples), or a pencil beam and a sharp lens assumed.
+/// What the fit did about an input's system response, for the report: convolved with what, or a
+/// pencil beam and a sharp lens assumed.
 std::string describe_system_response(const ProfileData& d, double beam_sigma_mm);
 
 }  // namespace lucent::fit::detail
