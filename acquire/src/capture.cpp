@@ -8,6 +8,7 @@
 #include "lucent/imaging/camera_raw.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
+#include "slab_fields.h"
 #include "lucent/materials/json_file.h"
 
 namespace lucent::acquire {
@@ -198,18 +199,7 @@ Capture capture_from_json(const nlohmann::json& doc, const std::string& source,
     c.ior = in.number(doc["ior"], "ior");
     if (!(*c.ior >= 0.25 && *c.ior <= 4)) in.fail("ior", "expected a relative index in [0.25, 4]");
   }
-  if (doc.contains("thickness_mm")) {
-    c.thickness_mm = in.number(doc["thickness_mm"], "thickness_mm");
-    if (!(*c.thickness_mm > 0 && *c.thickness_mm <= 1e4))
-      in.fail("thickness_mm", "expected a slab thickness in (0, 10000] mm");
-  }
-  if (doc.contains("side")) {
-    if (!doc["side"].is_string() || (doc["side"] != "reflected" && doc["side"] != "transmitted"))
-      in.fail("side", "expected \"reflected\" (the lit side) or \"transmitted\" (the far side)");
-    c.transmitted = doc["side"] == "transmitted";
-    if (c.transmitted && !c.thickness_mm)
-      in.fail("side", "\"transmitted\" needs the sample's thickness_mm");
-  }
+  detail::read_slab_fields(doc, source, c.thickness_mm, c.transmitted);
   if (doc.contains("beam_point_px")) {
     const json& p = doc["beam_point_px"];
     if (!p.is_array() || p.size() != 2) in.fail("beam_point_px", "expected [x, y] in pixels");

@@ -9,6 +9,7 @@
 #include "lucent/acquire/hdr_merge.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
+#include "slab_fields.h"
 #include "lucent/materials/json_file.h"
 
 namespace lucent::acquire {
@@ -242,18 +243,7 @@ Profile profile_from_json(const json& doc, const std::string& source) {
     p.ior = in.number(doc["ior"], "ior");
     if (!(*p.ior >= 0.25 && *p.ior <= 4)) in.fail("ior", "expected a relative index in [0.25, 4]");
   }
-  if (doc.contains("thickness_mm")) {
-    p.thickness_mm = in.number(doc["thickness_mm"], "thickness_mm");
-    if (!(*p.thickness_mm > 0 && *p.thickness_mm <= 1e4))
-      in.fail("thickness_mm", "expected a slab thickness in (0, 10000] mm");
-  }
-  if (doc.contains("side")) {
-    if (!doc["side"].is_string() || (doc["side"] != "reflected" && doc["side"] != "transmitted"))
-      in.fail("side", "expected \"reflected\" (the lit side) or \"transmitted\" (the far side)");
-    p.transmitted = doc["side"] == "transmitted";
-    if (p.transmitted && !p.thickness_mm)
-      in.fail("side", "\"transmitted\" needs the sample's thickness_mm");
-  }
+  detail::read_slab_fields(doc, source, p.thickness_mm, p.transmitted);
   if (doc.contains("system_response")) {
     const json& s = doc["system_response"];
     if (!s.is_object()) in.fail("system_response", "expected an object");

@@ -50,6 +50,30 @@ std::pair<double, double> core_and_glare(const ProfileData& d) {
   return {std::sqrt(second / energy), outside};
 }
 
+// The measured response at radius x, mm: linear between its rings, its first value inside them, 0
+// beyond the last.
+double measured_at(const ProfileData& d, double x) {
+  const std::vector<double>& kr = d.response_r_mm;
+  const std::vector<double>& kv = d.response_value;
+  if (x <= kr.front()) return std::max(0.0, kv.front());
+  if (x >= kr.back()) return 0.0;
+  const auto hi = std::size_t(std::upper_bound(kr.begin(), kr.end(), x) - kr.begin());
+  const double t = (x - kr[hi - 1]) / (kr[hi] - kr[hi - 1]);
+  return std::max(0.0, kv[hi - 1] + t * (kv[hi] - kv[hi - 1]));
+}
+
+// What a fit convolves with, for the report.
+std::string response_text(const ProfileData& d, double beam_sigma_mm) {
+  std::ostringstream what;
+  what.precision(3);
+  if (beam_sigma_mm > 0)
+    what << "a Gaussian beam of sigma " << beam_sigma_mm << " mm (--beam-sigma-mm)";
+  else
+    what << "the system response " << d.response_source << " (rms radius " << d.response_rms_mm
+         << " mm over the whole field)";
+  return what.str();
+}
+
 }  // namespace
 
 bool response_is_wide(const ProfileData& d) {
@@ -63,35 +87,20 @@ bool response_is_wide(const ProfileData& d) {
 
 // 2D samples: the grid convolution (convolution_2d.h) with a Gaussian of beam_sigma_mm (the
 // cells' own footprint is in the model), or the measured response where it is wide.
+// 2D samples: the grid convolution (convolution_2d.h) with a Gaussian of beam_sigma_mm (the
+// cells' own footprint is in the model), or the measured response where it is wide.
 static std::string attach_2d(Observations& o, const ProfileData& d, double beam_sigma_mm) {
   const bool gaussian = beam_sigma_mm > 0;
   if (!gaussian && !response_is_wide(d)) return "";
-  const std::vector<double>& kr = d.response_r_mm;
-  const std::vector<double>& kv = d.response_value;
   const auto density = [&](double x) {
-    if (gaussian)
-      return std::exp(-x * x / (2 * beam_sigma_mm * beam_sigma_mm)) /
-             (2 * std::numbers::pi * beam_sigma_mm * beam_sigma_mm);
-    if (x <= kr.front()) return std::max(0.0, kv.front());
-    if (x >= kr.back()) return 0.0;
-    const auto hi = std::size_t(std::upper_bound(kr.begin(), kr.end(), x) - kr.begin());
-    const double t = (x - kr[hi - 1]) / (kr[hi] - kr[hi - 1]);
-    return std::max(0.0, kv[hi - 1] + t * (kv[hi] - kv[hi - 1]));
+    return gaussian ? std::exp(-x * x / (2 * beam_sigma_mm * beam_sigma_mm)) /
+                          (2 * std::numbers::pi * beam_sigma_mm * beam_sigma_mm)
+                    : measured_at(d, x);
   };
   o.conv2d = make_convolution_2d(o.x, o.y, o.pixel, density,
-                                 gaussian ? 6 * beam_sigma_mm : kr.back());
-  std::ostringstream what;
-  what.precision(3);
-  if (gaussian)
-    what << "a Gaussian beam of sigma " << beam_sigma_mm << " mm (--beam-sigma-mm)";
-  else
-    what << "the system response " << d.response_source << " (rms radius " << d.response_rms_mm
-         << " mm over the whole field)";
-  what << " (2D samples: on a grid of cells, by FFT)";
-  return what.str();
+                                 gaussian ? 6 * beam_sigma_mm : d.response_r_mm.back());
+  return response_text(d, beam_sigma_mm) + " (2D samples: on a grid of cells, by FFT)";
 }
-
-
 
 std::string attach_system_response(Observations& o, const ProfileData& d, double beam_sigma_mm) {
   o.conv_nodes.clear();
@@ -109,15 +118,7 @@ std::string attach_system_response(Observations& o, const ProfileData& d, double
                : 0.0;
   const std::vector<double>& kr = d.response_r_mm;
   const std::vector<double>& kv = d.response_value;
-  // The measured response at radius x (linear between its rings, its first value inside them, 0
-  // beyond the last).
-  const auto kernel = [&](double x) {
-    if (x <= kr.front()) return std::max(0.0, kv.front());
-    if (x >= kr.back()) return 0.0;
-    const auto hi = std::size_t(std::upper_bound(kr.begin(), kr.end(), x) - kr.begin());
-    const double t = (x - kr[hi - 1]) / (kr[hi] - kr[hi - 1]);
-    return std::max(0.0, kv[hi - 1] + t * (kv[hi] - kv[hi - 1]));
-  };
+  const auto kernel = [&](double x) { return measured_at(d, x); };
   // Node spacing: an eighth of the Gaussian's sigma, or a sixth of the measured core's half width
   // at half maximum (the glare's long tail does not set it), never below a quarter pixel. (A
   // quarter sigma left the midpoint rule 0.7% high at the centre of a Gaussian.)
@@ -164,14 +165,7 @@ std::string attach_system_response(Observations& o, const ProfileData& d, double
       o.conv_weights[i * m + j] = h * s * a;
     }
   }
-  std::ostringstream what;
-  what.precision(3);
-  if (gaussian)
-    what << "a Gaussian beam of sigma " << beam_sigma_mm << " mm (--beam-sigma-mm)";
-  else
-    what << "the system response " << d.response_source << " (rms radius " << d.response_rms_mm
-         << " mm over the whole field)";
-  return what.str();
+  return response_text(d, beam_sigma_mm);
 }
 
 std::string describe_system_response(const ProfileData& d, double beam_sigma_mm) {
