@@ -135,6 +135,16 @@ materials::Material run(const FitArguments& a) {
   materials::TransportTable table;
   if (!a.table.empty()) {
     table = materials::read_transport_table(a.table);
+    // Given on purpose, so a table that cannot serve a radial fit is an error, not a quiet fall
+    // back to the diffusion models.
+    if (table.partial)
+      throw Error("--table " + a.table + ": a shard of a table build (kind partial): merge the "
+                  "shards first (lucent tabulate --merge)");
+    if (table.grid.phi_bins > 1)
+      throw Error("--table " + a.table + ": an oblique (2D) table: give it as --oblique-table");
+    if (table.slab())
+      throw Error("--table " + a.table + ": a slab's table: lucent fit builds those itself "
+                  "(--thickness-mm)");
     options.table = &table;
   }
   if (const materials::TransportTable* radial =

@@ -29,7 +29,12 @@ materials::TransportTable cached_or_built(
     const std::string& kind, bool quiet) {
   const std::filesystem::path dir = materials::oblique_cache_dir();
   const std::filesystem::path cached = dir.empty() ? std::filesystem::path() : dir / name;
-  if (!cached.empty() && std::filesystem::exists(cached)) {
+  const materials::CacheEntry entry =
+      cached.empty() ? materials::CacheEntry::kAbsent : materials::cache_entry(cached);
+  if (entry == materials::CacheEntry::kOther)
+    warn("lucent fit: warning: " + cached.string() +
+         ": not a regular file, ignored (a table built now replaces it)");
+  if (entry == materials::CacheEntry::kFile) {
     try {
       materials::TransportTable t = materials::read_transport_table(cached);
       if (has(t)) return t;
@@ -50,10 +55,15 @@ materials::TransportTable cached_or_built(
     std::filesystem::create_directories(dir, ec);
     try {
       if (ec) throw Error(dir.string() + ": " + ec.message());
+      // Not through the run's output transaction: the cache's own write commits nothing of the
+      // run's outputs (a batch interrupted after a build leaves none of its rows).
+      CacheWriteScope now;
       materials::write_transport_table(t, cached);
-      commit_pending_outputs();
     } catch (const Error& e) {
       warn("lucent fit: warning: the " + kind + " table is not kept (" + e.what() + ")");
+    } catch (const std::exception& e) {
+      warn("lucent fit: warning: the " + kind + " table is not kept (" + cached.string() + ": " +
+           e.what() + ")");
     }
   }
   t.source = cached.empty() ? std::string("(built for this fit)") : cached.string();

@@ -50,16 +50,56 @@ std::pair<double, double> core_and_glare(const ProfileData& d) {
   return {std::sqrt(second / energy), outside};
 }
 
-// The measured response at radius x, mm: linear between its rings, its first value inside them, 0
-// beyond the last.
-double measured_at(const ProfileData& d, double x) {
-  const std::vector<double>& kr = d.response_r_mm;
-  const std::vector<double>& kv = d.response_value;
-  if (x <= kr.front()) return std::max(0.0, kv.front());
-  if (x >= kr.back()) return 0.0;
-  const auto hi = std::size_t(std::upper_bound(kr.begin(), kr.end(), x) - kr.begin());
-  const double t = (x - kr[hi - 1]) / (kr[hi] - kr[hi - 1]);
-  return std::max(0.0, kv[hi - 1] + t * (kv[hi] - kv[hi - 1]));
+// The measured response as a function of radius, mm: linear between its rings, its first value
+// inside them; past the last ring above the noise, a power-law glare tail where the outer rings fall
+// like one, out to `reach` (else 0). A lens's veil falls as r^-3 far out; the white reference's rings
+// sink into its dark field's noise (they are 0 within 3 SE) well before the sample's own tail ends,
+// and that tail, six decades below its peak, still carries the veil of its bright centre: without
+// the tail a skin1 capture with 3% glare left 11 SD of structure in green (4.2 with it).
+struct MeasuredKernel {
+  const std::vector<double>* kr = nullptr;
+  const std::vector<double>* kv = nullptr;
+  double r_last = 0, v_last = 0, power = 0;  // the tail v_last (r_last / x)^power; power 0: none
+  double reach = 0;                          // 0 beyond
+  double operator()(double x) const {
+    const std::vector<double>& r = *kr;
+    const std::vector<double>& v = *kv;
+    if (x <= r.front()) return std::max(0.0, v.front());
+    if (power > 0 && x > r_last) return x < reach ? v_last * std::pow(r_last / x, power) : 0.0;
+    if (x >= r.back()) return 0.0;
+    const auto hi = std::size_t(std::upper_bound(r.begin(), r.end(), x) - r.begin());
+    const double t = (x - r[hi - 1]) / (r[hi] - r[hi - 1]);
+    return std::max(0.0, v[hi - 1] + t * (v[hi] - v[hi - 1]));
+  }
+};
+
+MeasuredKernel measured_kernel(const ProfileData& d, double reach_mm) {
+  MeasuredKernel k;
+  k.kr = &d.response_r_mm, k.kv = &d.response_value;
+  const std::vector<double>& r = d.response_r_mm;
+  const std::vector<double>& v = d.response_value;
+  k.reach = r.back();
+  // The last of two rings in a row above the noise (a lone one far out may be a fluctuation).
+  std::size_t last = 0;
+  for (std::size_t i = 1; i < r.size(); ++i)
+    if (v[i] > 0 && v[i - 1] > 0) last = i;
+  if (last < 4) return k;
+  // The outer rings' log-log slope, over the last factor of 2 in radius.
+  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (std::size_t i = 0; i <= last; ++i) {
+    if (!(v[i] > 0) || r[i] < 0.5 * r[last] || !(r[i] > 0)) continue;
+    const double x = std::log(r[i]), y = std::log(v[i]);
+    n += 1, sx += x, sy += y, sxx += x * x, sxy += x * y;
+  }
+  if (n < 4 || !(sxx * n - sx * sx > 0)) return k;
+  const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  // A power law (glare), not a Gaussian core's edge (slope -r^2/sigma^2: -16 at 4 sigma).
+  if (!(slope > -6 && slope < -1)) return k;
+  k.power = std::clamp(-slope, 2.0, 4.0);
+  k.r_last = r[last];
+  k.v_last = std::exp((sy + k.power * sx) / n) * std::pow(k.r_last, -k.power);  // the fitted line
+  k.reach = std::max(r.back(), reach_mm);
+  return k;
 }
 
 // What a fit convolves with, for the report.
@@ -92,13 +132,16 @@ bool response_is_wide(const ProfileData& d) {
 static std::string attach_2d(Observations& o, const ProfileData& d, double beam_sigma_mm) {
   const bool gaussian = beam_sigma_mm > 0;
   if (!gaussian && !response_is_wide(d)) return "";
+  double reach = 0;  // the samples' farthest distance from the entry
+  for (std::size_t i = 0; i < o.x.size(); ++i) reach = std::max(reach, std::hypot(o.x[i], o.y[i]));
+  const MeasuredKernel measured = gaussian ? MeasuredKernel{} : measured_kernel(d, 2 * reach);
   const auto density = [&](double x) {
     return gaussian ? std::exp(-x * x / (2 * beam_sigma_mm * beam_sigma_mm)) /
                           (2 * std::numbers::pi * beam_sigma_mm * beam_sigma_mm)
-                    : measured_at(d, x);
+                    : measured(x);
   };
   o.conv2d = make_convolution_2d(o.x, o.y, o.pixel, density,
-                                 gaussian ? 6 * beam_sigma_mm : d.response_r_mm.back());
+                                 gaussian ? 6 * beam_sigma_mm : measured.reach);
   return response_text(d, beam_sigma_mm) + " (2D samples: on a grid of cells, by FFT)";
 }
 
@@ -118,7 +161,8 @@ std::string attach_system_response(Observations& o, const ProfileData& d, double
                : 0.0;
   const std::vector<double>& kr = d.response_r_mm;
   const std::vector<double>& kv = d.response_value;
-  const auto kernel = [&](double x) { return measured_at(d, x); };
+  const MeasuredKernel kernel =
+      measured ? measured_kernel(d, 2 * o.r.back()) : MeasuredKernel{};
   // Node spacing: an eighth of the Gaussian's sigma, or a sixth of the measured core's half width
   // at half maximum (the glare's long tail does not set it), never below a quarter pixel. (A
   // quarter sigma left the midpoint rule 0.7% high at the centre of a Gaussian.)
@@ -133,7 +177,7 @@ std::string attach_system_response(Observations& o, const ProfileData& d, double
       }
   }
   const double h = std::max({gaussian ? sigma / 8 : core / 6, pixel / 4, 1e-3});
-  const double extent = gaussian ? 6 * sigma : kr.back();
+  const double extent = gaussian ? 6 * sigma : kernel.reach;
   const double s_max = o.r.back() + extent;
   const std::size_t m = std::size_t(std::ceil(s_max / h));
   for (std::size_t j = 0; j < m; ++j) o.conv_nodes.push_back((double(j) + 0.5) * h);
@@ -155,7 +199,7 @@ std::string attach_system_response(Observations& o, const ProfileData& d, double
         a = std::exp(-d2 / (2 * sigma * sigma)) * bessel_i0e(r * s / (sigma * sigma)) /
             (sigma * sigma);
       } else {
-        if (std::abs(r - s) >= kr.back()) continue;
+        if (std::abs(r - s) >= kernel.reach) continue;
         for (int k = 0; k < kAngles; ++k) {
           const double theta = (k + 0.5) * std::numbers::pi / kAngles;
           a += kernel(std::sqrt(std::max(0.0, r * r + s * s - 2 * r * s * std::cos(theta))));

@@ -149,12 +149,14 @@ void check_folder_holds_no_input_locked(const fs::path& folder, const Registry& 
 }
 
 // Renames now, or hands the rename to the open transaction.
+thread_local int cache_writes = 0;  // CacheWriteScope depth in this thread
+
 void finish(const fs::path& temporary, const fs::path& target, bool folder) {
   Registry& r = registry();
   {
     std::lock_guard lock(r.mutex);
     check_not_an_input_locked(target, r);
-    if (r.transaction && !inside_temporary_folder(target, r)) {
+    if (r.transaction && !inside_temporary_folder(target, r) && cache_writes == 0) {
       r.deferred.push_back({temporary, target, folder});
       return;
     }
@@ -442,6 +444,9 @@ OutputTransaction::~OutputTransaction() {
 }
 
 void OutputTransaction::commit() { commit_pending_outputs(); }
+
+CacheWriteScope::CacheWriteScope() { ++cache_writes; }
+CacheWriteScope::~CacheWriteScope() { --cache_writes; }
 
 void commit_pending_outputs() {
   Registry& r = registry();

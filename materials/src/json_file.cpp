@@ -2,6 +2,7 @@
 #include "lucent/materials/json_file.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -21,6 +22,14 @@ std::string read_input_file(const std::filesystem::path& path, std::size_t max_b
   }
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) throw Error(source + ": cannot open: " + std::strerror(errno));
+  // A regular file is judged by its size before a byte is read (a pipe or a device, by what it
+  // gives, below).
+  struct stat st {};
+  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && std::uint64_t(st.st_size) > max_bytes) {
+    ::close(fd);
+    throw Error(source + ": larger than " + std::to_string(max_bytes >> 20) +
+                " MiB; not a file lucent reads (is it the right file?)");
+  }
   note_input(path);
   std::string text;
   char chunk[1 << 16];

@@ -151,4 +151,12 @@ std::filesystem::path oblique_cache_dir() {
   return {};
 }
 
+CacheEntry cache_entry(const std::filesystem::path& path) {
+  std::error_code ec;
+  const std::filesystem::file_status st = std::filesystem::status(path, ec);
+  if (st.type() == std::filesystem::file_type::not_found) return CacheEntry::kAbsent;
+  if (ec) return CacheEntry::kOther;  // a loop, a folder that cannot be searched
+  return st.type() == std::filesystem::file_type::regular ? CacheEntry::kFile : CacheEntry::kOther;
+}
+
 }  // namespace lucent::materials

@@ -78,6 +78,8 @@ const TransportTable* cached_radial_slice(double eta, double g) {
   std::sort(candidates.begin(), candidates.end(),
             [](const auto& a, const auto& b) { return a.first > b.first; });
   for (const auto& [photons, path] : candidates) {
+    // Regular files only: a FIFO named like a slice would block the run (oblique.h, cache_entry).
+    if (cache_entry(path) != CacheEntry::kFile) continue;
     try {
       TransportTable t = read_transport_table(path);
       bool slice = false;

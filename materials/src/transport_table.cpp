@@ -34,6 +34,9 @@ constexpr const char* kFormat = "lucent-transport-table";
 constexpr int kVersion = 1;
 // A header line longer than this is not ours (and would be read whole before the check).
 constexpr std::size_t kMaxHeaderBytes = 1 << 20;
+// The largest table lucent reads (the shipped radial one is 1.2 MB; a slice at a fine grid tens of
+// MB): a mistaken multi-gigabyte file is refused by its size.
+constexpr std::size_t kMaxTableBytes = std::size_t(512) << 20;
 // An entry is measured when its relative standard error is below this; beyond the last measured
 // entry of a row the far tail is extrapolated (finish_transport_table).
 constexpr double kMeasuredRelativeSe = 0.25;
@@ -361,21 +364,19 @@ namespace {
 
 TransportTable read_transport_table_unchecked(const std::filesystem::path& path) {
   const std::string src = path.string();
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(src + ": cannot open the transport table");
-  std::string header;
-  char ch;
-  while (in.get(ch) && ch != '\n') {
-    header.push_back(ch);
-    if (header.size() > kMaxHeaderBytes) throw Error(src + ": not a lucent-transport-table (no header line)");
-  }
+  // The bounded reading path (json_file.h): a regular file larger than the limit is refused by its
+  // size before a byte is read, anything else stops at the limit.
+  const std::string file = read_input_file(path, kMaxTableBytes);
+  const std::size_t newline = file.find('\n');
+  if (newline == std::string::npos || newline > kMaxHeaderBytes)
+    throw Error(src + ": not a lucent-transport-table (no header line)");
+  const std::string header = file.substr(0, newline);
   json h;
   try {
     h = parse_json(header, src);
   } catch (const Error&) {
     throw Error(src + ": not a lucent-transport-table (the first line is not valid JSON)");
   }
-  note_input(path);
   const auto field = [&](const char* name) -> const json& {
     if (!h.is_object() || !h.contains(name)) throw Error(src + ": missing field '" + name + "'");
     return h.at(name);
@@ -418,14 +419,20 @@ TransportTable read_transport_table_unchecked(const std::filesystem::path& path)
   } catch (const json::exception& e) {
     throw Error(src + ": grid, slices or groups: unexpected value (" + std::string(e.what()) + ")");
   }
+  // Every value checked before it sizes anything: a table is a document like any other, its
+  // checksum says only that the bytes are the ones written.
   bool grid_ok = t.grid.u.size() >= 2 && t.grid.u.size() <= 4096 && t.grid.u.front() == 0 &&
+                 std::isfinite(t.grid.rho_min) && std::isfinite(t.grid.rho_max) &&
                  t.grid.rho_min > 0 && t.grid.rho_max > t.grid.rho_min &&
-                 t.grid.rho_per_decade >= 1 && t.grid.rho_per_decade <= 200 && t.groups >= 2 &&
-                 t.grid.phi_bins >= 1 && t.grid.phi_bins <= 360;
+                 t.grid.rho_max / t.grid.rho_min <= 1e12 && t.grid.rho_per_decade >= 1 &&
+                 t.grid.rho_per_decade <= 200 && t.groups >= 2 && t.groups <= 1 << 20 &&
+                 t.grid.phi_bins >= 1 && t.grid.phi_bins <= 360 && t.grid.rho_bins() >= 2 &&
+                 std::isfinite(t.max_path) && t.max_path > 0;
   for (std::size_t k = 1; grid_ok && k < t.grid.u.size(); ++k)
     grid_ok = t.grid.u[k] > t.grid.u[k - 1] && t.grid.u[k] < 1;
   if (!grid_ok)
-    throw Error(src + ": grid: expected rising u nodes in [0, 1), a rho range and 1..360 phi_bins");
+    throw Error(src + ": grid: expected rising u nodes in [0, 1), a finite rho range of at least 2 "
+                      "bins, 1..360 phi_bins, 2 or more groups and a finite max_path");
   if (t.slice_axes.empty()) throw Error(src + ": slices: expected at least one");
   for (const auto& a : t.slice_axes)
     if (!(a[0] >= 1 && a[0] <= 2.5 && a[1] >= 0 && a[1] < 1 && a[2] >= 1 && a[3] >= 0 &&
@@ -433,11 +440,30 @@ TransportTable read_transport_table_unchecked(const std::filesystem::path& path)
       throw Error(src + ": slices: eta in [1, 2.5], g in [0, 1), photons >= 1 and "
                   "incidence_deg in [0, 90) expected");
 
-  std::string payload((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string_view payload_view(file.data() + newline + 1, file.size() - newline - 1);
+  const std::string payload(payload_view);
   const std::uint64_t declared = whole_number<std::uint64_t>(field("payload_bytes"), src, "payload_bytes");
   if (payload.size() != declared)
     throw Error(src + ": payload_bytes: the header says " + std::to_string(declared) +
                 " bytes, the file holds " + std::to_string(payload.size()));
+  // What the header's grid and slices (or groups) take, against what is there, before any array
+  // is sized from them.
+  {
+    const double n = double(t.grid.entries()), K = double(t.grid.u.size());
+    double expected = 0;
+    if (!t.partial) {
+      expected = double(t.slice_axes.size()) *
+                 (kTableQuantities * n * (sizeof(float) + sizeof(std::uint8_t)) + 2 * K * sizeof(double));
+    } else {
+      const json& groups = field("partial_groups");
+      if (!groups.is_array()) throw Error(src + ": partial_groups: expected an array");
+      expected = double(groups.size()) * (kTableQuantities * n + K) * sizeof(double);
+    }
+    if (expected != double(payload.size()))
+      throw Error(src + ": payload_bytes: the grid and slices need " +
+                  std::to_string(std::uint64_t(expected)) + " bytes, the file holds " +
+                  std::to_string(payload.size()));
+  }
   const std::uint64_t crc =
       crc32(0L, reinterpret_cast<const Bytef*>(payload.data()), uInt(payload.size()));
   if (crc != whole_number<std::uint64_t>(field("crc32"), src, "crc32"))
@@ -462,6 +488,10 @@ TransportTable read_transport_table_unchecked(const std::filesystem::path& path)
       s.total.resize(K), s.total_se.resize(K);
       r.get(s.total.data(), K, "totals");
       r.get(s.total_se.data(), K, "totals");
+      for (std::size_t k = 0; k < K; ++k)
+        if (!(s.total[k] >= 0 && s.total[k] <= 1 && s.total_se[k] >= 0 && std::isfinite(s.total_se[k])))
+          throw Error(src + ": totals: expected total reflectances in [0, 1] with finite standard "
+                            "errors >= 0");
       t.slices.push_back(std::move(s));
     }
   } else {
@@ -476,9 +506,14 @@ TransportTable read_transport_table_unchecked(const std::filesystem::path& path)
       for (int q = 0; q < kTableQuantities; ++q) {
         g.value[std::size_t(q)].resize(n);
         r.get(g.value[std::size_t(q)].data(), n, "group values");
+        for (double v : g.value[std::size_t(q)])
+          if (!(v >= 0 && std::isfinite(v)))
+            throw Error(src + ": group values: expected finite entries >= 0");
       }
       g.total.resize(K);
       r.get(g.total.data(), K, "group totals");
+      for (double v : g.total)
+        if (!(v >= 0 && v <= 1)) throw Error(src + ": group totals: expected values in [0, 1]");
       t.partial_groups.push_back(std::move(g));
     }
   }

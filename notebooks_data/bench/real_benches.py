@@ -22,9 +22,9 @@ cases = [
 ]
 print("| bench (simulated, 1e6 photons, white reference through the same lens) | fit | worst error | worst abs z | fit time |")
 print("| --- | --- | --- | --- | --- |")
-for name, material, sim, fit in cases:
-    d = os.path.join(work, name.split(",")[0].replace(" ", "_") + str(abs(hash(name)) % 10000))
-    subprocess.run(f"rm -rf {d}", shell=True)
+for k, (name, material, sim, fit) in enumerate(cases):
+    d = os.path.join(work, f"case{k}")
+    subprocess.run(f"rm -rf {d} && mkdir -p {d}", shell=True)
     subprocess.run(f"{lucent} simulate --material {material} -o {d}/sim --photons 1000000 --seed 11 -q {sim}",
                    shell=True, check=True)
     subprocess.run(f"{lucent} acquire {d}/sim/capture.json -q -o {d}/acq", shell=True, check=True,

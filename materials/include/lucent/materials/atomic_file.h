@@ -101,6 +101,17 @@ class OutputTransaction {
   void commit();
 };
 
+/// While one is alive (in this thread), the atomic writers above rename into place at once even
+/// with a transaction open: for cache entries, which are not a run's outputs (a run that fails
+/// later keeps them, and writing them commits none of the run's outputs).
+class CacheWriteScope {
+ public:
+  CacheWriteScope();
+  ~CacheWriteScope();
+  CacheWriteScope(const CacheWriteScope&) = delete;
+  CacheWriteScope& operator=(const CacheWriteScope&) = delete;
+};
+
 /// A warning for stderr (one line, without the trailing newline). While a transaction is open it
 /// waits for the commit, so that a run that fails prints its one error line and nothing else;
 /// without one it is printed at once.

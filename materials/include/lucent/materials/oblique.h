@@ -178,4 +178,10 @@ class ObliqueModel {
 /// $HOME/.cache/lucent (empty when none is set).
 std::filesystem::path oblique_cache_dir();
 
+/// What a cache entry is: absent, a regular file lucent may open (a symlink to one included), or
+/// something else (a FIFO, device, directory, dangling or looping link, an unreadable folder):
+/// never opened (a FIFO would block the run), warned about, and replaced when lucent writes there.
+enum class CacheEntry { kAbsent, kFile, kOther };
+CacheEntry cache_entry(const std::filesystem::path& path);
+
 }  // namespace lucent::materials
