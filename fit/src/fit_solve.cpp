@@ -131,7 +131,12 @@ ModelFit solve(const std::vector<ProfileData>& data, const FitOptions& options, 
   p.eta = eta0;
   p.log_scale = relative ? start[0].log_scale : 0.0;
   for (int c = 0; c < 3; ++c) {
-    p.ab[c] = {std::log(start[c].sigma_a), std::log(start[c].sigma_s_reduced)};
+    // A start from a fit whose sigma_a ran to 0 (an absorption its data cannot see: exp of a very
+    // negative log underflows) is a start just above it: log 0 made every refit from it fail at
+    // once, and a 1 mm skim milk slab's systematic came out 0 (its truth 10 SD away).
+    const auto positive = [](double v) { return std::isfinite(v) && v > 1e-300 ? v : 1e-300; };
+    p.ab[c] = {std::log(std::max(positive(start[c].sigma_a), 1e-12 * positive(start[c].sigma_s_reduced))),
+               std::log(positive(start[c].sigma_s_reduced))};
   }
   ceres::Problem problem;
   std::array<int, 3> samples{};
