@@ -45,6 +45,7 @@ struct FitArguments {
   double beam_pixel_mm = 0;  // 0: the first input's pixel pitch
   bool fit_ior = false, relative = false, json = false, allow_unconverged = false;
   bool fit_thickness = false;
+  bool allow_outside = false;  // --batch: row outputs outside the manifest's folder
   bool plot_log_r = false;  // --plot-log-r
 };
 
@@ -118,6 +119,7 @@ materials::Material run(const FitArguments& a) {
     fit::check_fit_plot_path(a.plot, "--plot");
   }
   if (!a.report.empty()) check_output_file(a.report, ".json", "--report");
+  check_distinct_outputs({{"-o", a.output}, {"--plot", a.plot}, {"--report", a.report}});
   std::vector<fit::ProfileData> data;
   for (const std::string& input : a.inputs) {
     data.push_back(fit::load_profile_data(input));
@@ -249,6 +251,7 @@ void run_batch(const FitArguments& a) {
   check_output_file(a.output, ".json", "-o");
   const auto [shard, shards] = a.shard.empty() ? std::pair{0, 1} : parse_shard(a.shard, "--shard");
   const std::vector<BatchRow> rows = read_batch_manifest(a.batch);
+  plan_batch_outputs(rows, a.batch, a.output, a.allow_outside);
   std::vector<BatchOutcome> outcomes;
   int failed = 0;
   std::uint64_t mine = 0;
@@ -297,9 +300,23 @@ void run_batch(const FitArguments& a) {
     progress.update(outcomes.size(), mine);
   }
   progress.finish();
+  // What every row was fitted with: shards merge only when this agrees.
+  const nlohmann::json run = {
+      {"manifest_fnv1a", file_hash(a.batch)},
+      {"options",
+       {{"model", a.model}, {"g", a.g}, {"quality", a.quality}, {"loss", a.loss},
+        {"ior", a.ior_option && a.ior_option->count() > 0 ? nlohmann::json(a.ior) : nlohmann::json()},
+        {"fit_ior", a.fit_ior}, {"relative", a.relative}, {"thickness_mm", a.thickness_mm},
+        {"fit_thickness", a.fit_thickness}, {"beam_sigma_mm", a.beam_sigma_mm},
+        {"beam_image", a.beam_image}, {"table", a.table}, {"oblique_table", a.oblique_table},
+        {"table_photons", a.table_photons}, {"slab_photons", a.slab_photons},
+        {"oblique_photons", a.oblique_photons}, {"allow_unconverged", a.allow_unconverged},
+        {"exclude_radius_mm", a.exclude_option && a.exclude_option->count() > 0
+                                  ? nlohmann::json(a.exclude_radius_mm)
+                                  : nlohmann::json()}}}};
   const nlohmann::json summary =
       batch_summary(a.batch, rows.size(), outcomes,
-                    shards > 1 ? std::to_string(shard) + "/" + std::to_string(shards) : "");
+                    shards > 1 ? std::to_string(shard) + "/" + std::to_string(shards) : "", run);
   check_finite_json(summary, a.output);
   write_file_atomically(a.output, summary.dump(2) + "\n");
   std::cout << "fitted " << outcomes.size() - std::size_t(failed) << " of " << outcomes.size()
@@ -356,6 +373,10 @@ void register_fit_command(CLI::App& app) {
                   "input says, thickness_mm and side, else semi-infinite); its tables are built "
                   "on first use and kept in ~/.cache/lucent")
       ->check(number_in(1e-3, 1e4, "mm"));
+  cmd->add_flag("--allow-outside", args->allow_outside,
+                "--batch: let rows write outside the manifest's folder (a job array writing to a "
+                "scratch tree); without it such a row is refused before anything is fitted, so "
+                "that a manifest from elsewhere cannot replace files of yours");
   cmd->add_flag("--fit-thickness", args->fit_thickness,
                 "the sample is a slab of unknown thickness: fit it (one for every input) and say "
                 "how well the data pin it, or that they cannot (named undetermined); uses the "

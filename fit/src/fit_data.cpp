@@ -334,7 +334,11 @@ ProfileData profile_data_from_json(const nlohmann::json& doc, const std::string&
 ProfileData load_profile_data(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
   for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-  if (ext == ".csv") return parse_profile_csv(read_input_file(path), path.string());
+  if (ext == ".csv") {
+    std::string text = read_input_file(path);
+    if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);  // a UTF-8 byte order mark
+    return parse_profile_csv(text, path.string());
+  }
   if (ext == ".json") return profile_data_from_json(read_json_file(path), path.string());
   throw Error(path.string() + ": expected a lucent-profile .json (from lucent acquire) or a .csv");
 }

@@ -29,6 +29,10 @@ namespace fs = std::filesystem;
 namespace lucent {
 namespace {
 
+// CacheWriteScope depth in this thread: cache entries commit at once and may replace what the run
+// read (a corrupt entry read, refused and rebuilt is lucent's own file, not a user's input).
+thread_local int cache_writes = 0;
+
 struct Deferred {
   fs::path temporary, target;
   bool folder = false;
@@ -149,13 +153,11 @@ void check_folder_holds_no_input_locked(const fs::path& folder, const Registry& 
 }
 
 // Renames now, or hands the rename to the open transaction.
-thread_local int cache_writes = 0;  // CacheWriteScope depth in this thread
-
 void finish(const fs::path& temporary, const fs::path& target, bool folder) {
   Registry& r = registry();
   {
     std::lock_guard lock(r.mutex);
-    check_not_an_input_locked(target, r);
+    if (cache_writes == 0) check_not_an_input_locked(target, r);
     if (r.transaction && !inside_temporary_folder(target, r) && cache_writes == 0) {
       r.deferred.push_back({temporary, target, folder});
       return;
@@ -287,7 +289,7 @@ void write_file_atomically(const fs::path& path, std::string_view content, bool 
                   " would hold a non-finite number (lucent writes only finite values)");
     }
   }
-  check_not_an_input(path);
+  if (cache_writes == 0) check_not_an_input(path);
   sweep_dead_temporaries(folder_of(path));
   const fs::path temporary =
       folder_of(path) / ("." + path.filename().string() + temporary_suffix());
