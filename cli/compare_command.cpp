@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "validators.h"
 #include "lucent/imaging/image_io.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
@@ -33,6 +34,23 @@ void run_compare(const CompareArguments& args) {
   if (!args.difference.empty()) check_output_file(args.difference, "", "--difference");
   const render::ImageRgb image = imaging::read_exr(args.image);
   const render::ImageRgb reference = imaging::read_exr(args.reference);
+  // Renders are radiance: finite and >= 0 (a NaN or negative pixel made a NaN or negative RMSE).
+  for (const auto& [im, path] : {std::pair{&image, &args.image}, std::pair{&reference, &args.reference}})
+    for (std::size_t i = 0; i < im->data.size(); ++i)
+      if (!std::isfinite(im->data[i]) || im->data[i] < 0) {
+        const std::size_t p = i / 3;
+        throw Error(*path + ": pixel (" + std::to_string(p % std::size_t(im->width)) + ", " +
+                    std::to_string(p / std::size_t(im->width)) + ") is " +
+                    (std::isfinite(im->data[i]) ? "negative" : "not finite") +
+                    ": expected a linear render (radiance >= 0)");
+      }
+  if (image.width != reference.width || image.height != reference.height)
+    throw Error(args.image + ": " + std::to_string(image.width) + " x " +
+                std::to_string(image.height) + " pixels, the reference " + args.reference + " " +
+                std::to_string(reference.width) + " x " + std::to_string(reference.height));
+  bool lit = false;
+  for (const float v : reference.data) lit = lit || v > 0;
+  if (!lit) throw Error(args.reference + ": the reference is black: nothing to compare against");
   const render::ImageDifference d =
       render::compare_images(image, reference, render::nonzero_mask(reference));
   if (!args.difference.empty()) {
@@ -106,6 +124,7 @@ void register_compare_command(CLI::App& app) {
   cmd->add_flag("--signed", args->signed_difference,
                 "--difference: red where the image is brighter, blue where darker");
   cmd->add_option("--scale", args->scale, "--difference: multiplier before the tone curve")
+      ->check(number_in(0, 1e9, "a multiplier", true))
       ->capture_default_str();
   cmd->add_flag("--fit-scale", args->fit_scale,
                 "also the least-squares scale of the image to the reference, the relative RMSE "

@@ -12,6 +12,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <fstream>
+#include <cstdint>
 #include <cmath>
 #include <mutex>
 #include <opencv2/core/utils/logger.hpp>
@@ -71,6 +73,20 @@ cv::Mat decode_image_quietly(const std::filesystem::path& path, int flags) {
   (void)silenced;
   // Read by lucent (bounded, recorded as an input), decoded from memory by OpenCV.
   const std::string bytes = read_input_file(path, std::size_t(1) << 30);
+  // A PNG's size is in its header: judged before the decoder allocates for it (a 1.2 MB PNG of
+  // 20000^2 was decoded whole, 1.2 GB, before the check below).
+  if (bytes.size() >= 24 && bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0 &&
+      bytes.compare(12, 4, "IHDR") == 0) {
+    const auto be32 = [&](std::size_t at) {
+      return (std::uint32_t(std::uint8_t(bytes[at])) << 24) |
+             (std::uint32_t(std::uint8_t(bytes[at + 1])) << 16) |
+             (std::uint32_t(std::uint8_t(bytes[at + 2])) << 8) | std::uint32_t(std::uint8_t(bytes[at + 3]));
+    };
+    const long long w = be32(16), h = be32(20);
+    if (w > 16384 || h > 16384 || w * h > kMaxPixels)
+      throw Error(path.string() + ": the PNG's header says " + std::to_string(w) + " x " +
+                  std::to_string(h) + " pixels, larger than 16384 x 16384");
+  }
   const cv::Mat buffer(1, static_cast<int>(bytes.size()), CV_8U, const_cast<char*>(bytes.data()));
   cv::Mat mat;
   try {
@@ -110,14 +126,30 @@ ImageRgb read_exr(const std::filesystem::path& path) {
   if (!std::filesystem::is_regular_file(path))
     throw Error(path.string() + ": not a regular file (expected an OpenEXR image)");
   note_input(path);
+  {
+    // OpenEXR's own word for another format is "File is not an image file".
+    std::ifstream in(path, std::ios::binary);
+    char magic[4] = {};
+    in.read(magic, 4);
+    if (!in || std::string(magic, 4) != std::string("\x76\x2f\x31\x01", 4))
+      throw Error(path.string() + ": not an OpenEXR image (expected a linear .exr file)");
+  }
   try {
     Imf::InputFile file(path.c_str());
     const Imath::Box2i window = file.header().dataWindow();
     const long long width = static_cast<long long>(window.max.x) - window.min.x + 1;
     const long long height = static_cast<long long>(window.max.y) - window.min.y + 1;
     if (width <= 0 || height <= 0) throw Error(path.string() + ": empty OpenEXR image");
-    if (width * height > kMaxPixels)
+    if (width > 16384 || height > 16384 || width * height > kMaxPixels)
       throw Error(path.string() + ": the OpenEXR image is larger than 16384 x 16384 pixels");
+    // What the header claims against the bytes there: no codec packs float pixels 4096 to 1 (an
+    // 11.6 KB file claiming 16384^2 pixels drove memory to 3.2 GB).
+    std::error_code ec;
+    const auto bytes = std::filesystem::file_size(path, ec);
+    if (!ec && double(width) * double(height) * 12 > 4096.0 * double(bytes))
+      throw Error(path.string() + ": the OpenEXR header claims " + std::to_string(width) + " x " +
+                  std::to_string(height) + " pixels in " + std::to_string(bytes) +
+                  " bytes: not an image lucent reads (truncated or forged)");
     const Imf::ChannelList& channels = file.header().channels();
     const bool rgb =
         channels.findChannel("R") && channels.findChannel("G") && channels.findChannel("B");
@@ -129,13 +161,19 @@ ImageRgb read_exr(const std::filesystem::path& path) {
     const std::size_t xs = sizeof(float) * 3, ys = xs * width;
     char* base = reinterpret_cast<char*>(image.data.data()) -
                  (std::ptrdiff_t(window.min.x) * xs + std::ptrdiff_t(window.min.y) * ys);
+    // R, G, B as they are; a luminance image (Y alone) is grey: Y in all three (a frame buffer
+    // holds one slice per name, so Y goes into red and is copied: inserted three times it filled
+    // blue alone).
     const char* names[3] = {"R", "G", "B"};
-    for (int c = 0; c < 3; ++c) {
+    for (int c = 0; c < (rgb ? 3 : 1); ++c) {
       frame.insert(rgb ? names[c] : "Y",
                    Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xs, ys, 1, 1, 0.0));
     }
     file.setFrameBuffer(frame);
     file.readPixels(window.min.y, window.max.y);
+    if (!rgb)
+      for (std::size_t i = 0; i < image.data.size(); i += 3)
+        image.data[i + 1] = image.data[i + 2] = image.data[i];
     return image;
   } catch (const Error&) {
     throw;

@@ -10,6 +10,8 @@
 #include <cstdint>
 #include <limits>
 
+#include <cstring>
+
 #include "bad_input.h"
 #include "lucent/imaging/image_io.h"
 #include "raw_exr.h"
@@ -52,6 +54,38 @@ std::string be32(std::uint32_t v) {
 }
 
 // A PNG whose header claims 100000 x 100000 pixels and has no image data.
+// A PNG whose header claims w x h pixels and holds none (refused by its header, before decoding).
+std::string png_claiming(std::uint32_t w, std::uint32_t h) {
+  const std::string ihdr = "IHDR" + be32(w) + be32(h) + std::string("\x08\x02\0\0\0", 5);
+  return std::string("\x89PNG\r\n\x1a\n", 8) + be32(13) + ihdr + be32(crc32(ihdr)) + be32(0) +
+         "IEND" + be32(crc32("IEND"));
+}
+
+// A small real EXR whose dataWindow is patched to claim 16384 x 16384 pixels.
+void write_forged_exr(const fs::path& path) {
+  {
+    Imf::Header header(4, 4);
+    header.channels().insert("R", Imf::Channel(Imf::FLOAT));
+    header.channels().insert("G", Imf::Channel(Imf::FLOAT));
+    header.channels().insert("B", Imf::Channel(Imf::FLOAT));
+    std::vector<float> v(48, 1.0f);
+    Imf::OutputFile file(path.c_str(), header);
+    Imf::FrameBuffer frame;
+    for (int c = 0; c < 3; ++c)
+      frame.insert(std::string(1, "RGB"[c]),
+                   Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(v.data() + c), 12, 48));
+    file.setFrameBuffer(frame);
+    file.writePixels(4);
+  }
+  std::string b = read_bytes(path);
+  const std::string key = std::string("dataWindow\0box2i\0", 17);
+  const std::size_t at = b.find(key);
+  if (at == std::string::npos) return;
+  const std::int32_t box[4] = {0, 0, 16383, 16383};
+  std::memcpy(b.data() + at + key.size() + 4, box, sizeof box);
+  write_file(path, b);
+}
+
 std::string png_bomb() {
   const std::string ihdr = "IHDR" + be32(100000) + be32(100000) + std::string("\x08\x02\0\0\0", 5);
   return std::string("\x89PNG\r\n\x1a\n", 8) + be32(13) + ihdr + be32(crc32(ihdr)) + be32(0) +
@@ -154,6 +188,12 @@ std::vector<BadCase> bracket_cases() {
       {"bracket_jpeg_bytes_as_png", capture_with("image", bytes_at("\xff\xd8\xff\xe0garbage")),
        args, "img.png"},
       {"capture_hdr_text", capture_hdr(bytes_at("not an exr")), args, "h.exr"},
+      {"bracket_png_header_20000", capture_with("image", bytes_at(png_claiming(20000, 20000))),
+       args, "20000 x 20000"},
+      {"bracket_png_header_wide", capture_with("image", bytes_at(png_claiming(40000, 2))), args,
+       "img.png"},
+      {"capture_hdr_header_claims_16384_squared", capture_hdr(write_forged_exr), args,
+       "h.exr"},
   };
 }
 

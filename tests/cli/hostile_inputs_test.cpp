@@ -2,6 +2,10 @@
 // blindly"): batch outputs planned before any is written, transport tables checked field by field
 // beyond their checksum, the cache's odd entries. Each refusal: exit 1 or 2, one stderr line naming
 // the culprit, nothing written, no temporary, no input changed (bad_input.h).
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfOutputFile.h>
 #include <sys/stat.h>
 #include <zlib.h>
 
@@ -182,6 +186,112 @@ class TransportTables : public ::testing::TestWithParam<BadCase> {};
 TEST_P(TransportTables, AreCheckedBeyondTheirChecksum) { expect_clean_refusal(GetParam()); }
 INSTANTIATE_TEST_SUITE_P(Table, TransportTables, ::testing::ValuesIn(table_cases()),
                          [](const auto& info) { return info.param.name; });
+
+// ---- images ---------------------------------------------------------------------------------------
+
+// An EXR of w x h pixels with these channels ("RGB" or "Y"), each pixel's values from `value`.
+void write_exr_of(const fs::path& path, int w, int h, const std::string& channels,
+                  const std::function<float(int x, int y, int c)>& value) {
+  Imf::Header header(w, h);
+  for (const char ch : channels) header.channels().insert(std::string(1, ch), Imf::Channel(Imf::FLOAT));
+  const std::size_t n = channels.size();
+  std::vector<float> v(std::size_t(w) * h * n);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (std::size_t c = 0; c < n; ++c) v[(std::size_t(y) * w + x) * n + c] = value(x, y, int(c));
+  Imf::OutputFile file(path.c_str(), header);
+  Imf::FrameBuffer frame;
+  for (std::size_t c = 0; c < n; ++c)
+    frame.insert(std::string(1, channels[c]),
+                 Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(v.data() + c), sizeof(float) * n,
+                            sizeof(float) * n * std::size_t(w)));
+  file.setFrameBuffer(frame);
+  file.writePixels(h);
+}
+
+std::function<void(const fs::path&)> two_exrs(
+    std::function<float(int, int, int)> image, std::function<float(int, int, int)> reference,
+    int w = 8, int reference_w = 8) {
+  return [=](const fs::path& dir) {
+    write_exr_of(dir / "a.exr", w, 8, "RGB", image);
+    write_exr_of(dir / "b.exr", reference_w, 8, "RGB", reference);
+  };
+}
+
+std::vector<BadCase> compare_cases() {
+  const std::string cmp = "compare {dir}/a.exr {dir}/b.exr";
+  const auto one = [](int, int, int) { return 1.0f; };
+  return {
+      {"image_nan", two_exrs([](int x, int, int) { return x == 3 ? NAN : 1.0f; }, one), cmp,
+       "a.exr: pixel (3, 0) is not finite"},
+      {"image_infinite", two_exrs([](int x, int y, int) { return x + y == 5 ? INFINITY : 1.0f; }, one),
+       cmp, "a.exr: pixel"},
+      {"image_negative", two_exrs([](int, int y, int) { return y == 2 ? -1.0f : 1.0f; }, one), cmp,
+       "a.exr: pixel (0, 2) is negative"},
+      {"reference_nan", two_exrs(one, [](int, int, int c) { return c == 1 ? NAN : 1.0f; }), cmp,
+       "b.exr: pixel"},
+      {"reference_negative", two_exrs(one, [](int, int, int) { return -2.0f; }), cmp,
+       "b.exr: pixel"},
+      {"reference_black", two_exrs(one, [](int, int, int) { return 0.0f; }), cmp,
+       "b.exr: the reference is black"},
+      {"sizes_differ", two_exrs(one, one, 8, 9), cmp, "a.exr: 8 x 8 pixels"},
+      {"a_png_as_the_image",
+       [](const fs::path& dir) {
+         write_file(dir / "a.exr", "\x89PNG\r\n\x1a\nnot really");
+         write_exr_of(dir / "b.exr", 8, 8, "RGB", [](int, int, int) { return 1.0f; });
+       },
+       cmp, "a.exr: not an OpenEXR image"},
+      {"scale_nan", two_exrs(one, one), cmp + " --difference {dir}/d.png --scale nan", "--scale"},
+      {"scale_negative", two_exrs(one, one), cmp + " --difference {dir}/d.png --scale -5",
+       "--scale"},
+      {"scale_zero", two_exrs(one, one), cmp + " --difference {dir}/d.png --scale 0", "--scale"},
+      {"image_empty_file",
+       [](const fs::path& dir) {
+         write_file(dir / "a.exr", "");
+         write_exr_of(dir / "b.exr", 8, 8, "RGB", [](int, int, int) { return 1.0f; });
+       },
+       cmp, "a.exr"},
+      {"image_a_folder",
+       [](const fs::path& dir) {
+         fs::create_directory(dir / "a.exr");
+         write_exr_of(dir / "b.exr", 8, 8, "RGB", [](int, int, int) { return 1.0f; });
+       },
+       cmp, "a.exr"},
+      {"image_missing",
+       [](const fs::path& dir) {
+         write_exr_of(dir / "b.exr", 8, 8, "RGB", [](int, int, int) { return 1.0f; });
+       },
+       cmp, "a.exr"},
+      {"image_z_only",
+       [](const fs::path& dir) {
+         write_exr_of(dir / "a.exr", 8, 8, "Z", [](int, int, int) { return 1.0f; });
+         write_exr_of(dir / "b.exr", 8, 8, "RGB", [](int, int, int) { return 1.0f; });
+       },
+       cmp, "a.exr: OpenEXR image has neither"},
+  };
+}
+
+class CompareImages : public ::testing::TestWithParam<BadCase> {};
+TEST_P(CompareImages, AreRefusedCleanly) { expect_clean_refusal(GetParam()); }
+INSTANTIATE_TEST_SUITE_P(Table, CompareImages, ::testing::ValuesIn(compare_cases()),
+                         [](const auto& info) { return info.param.name; });
+
+// A luminance-only EXR (Y) is grey: Y in R, G and B (it was read into blue alone: acquire wrote
+// R = G = 0, a grey environment lit the object blue). Compared with the RGB image of the same
+// values: relative RMSE 0, every channel's mean ratio 1.
+TEST(Images, ALuminanceOnlyExrIsGrey) {
+  const fs::path dir = scratch_dir("hostile-y-exr");
+  const auto value = [](int x, int y, int) { return 0.25f + 0.01f * float(x + 3 * y); };
+  write_exr_of(dir / "y.exr", 8, 8, "Y", value);
+  write_exr_of(dir / "rgb.exr", 8, 8, "RGB", value);
+  const CommandResult r = run_lucent("compare \"" + (dir / "y.exr").string() + "\" \"" +
+                                     (dir / "rgb.exr").string() + "\" --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_NEAR(j["relative_rmse"].get<double>(), 0.0, 1e-7);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(j["mean_ratio"][c].get<double>(), 1.0, 1e-7) << c;
+  fs::remove_all(dir);
+}
 
 // ---- the cache ----------------------------------------------------------------------------------
 
