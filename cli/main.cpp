@@ -2,6 +2,8 @@
 #include <iostream>
 #include <new>
 
+#include <nlohmann/json.hpp>
+
 #include "commands.h"
 #include "lucent/materials/atomic_file.h"
 #include "lucent/materials/error.h"
@@ -46,17 +48,26 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     // One line, naming the option, instead of CLI11's two-line message.
-    std::cerr << "lucent: error: " << e.what() << " (see lucent --help)\n";
+    std::cerr << "lucent: error: " << lucent::printable(e.what()) << " (see lucent --help)\n";
     return 2;
   } catch (const lucent::Error& e) {
-    std::cerr << "lucent: error: " << e.what() << '\n';
+    std::cerr << "lucent: error: " << lucent::printable(e.what()) << '\n';
     return 1;
+  } catch (const nlohmann::json::type_error& e) {
+    // A name or path going into a JSON file that is not UTF-8 (nlohmann refuses to write it).
+    if (e.id == 316) {
+      std::cerr << "lucent: error: a name or file name going into a JSON file is not valid UTF-8 "
+                   "(" << lucent::printable(e.what()) << "); nothing written\n";
+      return 1;
+    }
+    std::cerr << "lucent: internal error: " << lucent::printable(e.what()) << '\n';
+    return 3;
   } catch (const std::bad_alloc&) {
     std::cerr << "lucent: error: out of memory (an input or a setting asks for more memory than "
                  "this machine has)\n";
     return 1;
   } catch (const std::exception& e) {
-    std::cerr << "lucent: internal error: " << e.what() << '\n';
+    std::cerr << "lucent: internal error: " << lucent::printable(e.what()) << '\n';
     return 3;
   }
   return 0;

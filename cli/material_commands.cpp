@@ -30,7 +30,7 @@ void run_export(const ExportArguments& a) {
   const materials::ExportResult r = materials::export_material(m, target, mm_per_unit);
   write_file_atomically(a.output, r.text);
   if (a.quiet) return;
-  std::printf("wrote %s (%s, scene unit %s = %g mm)\n", a.output.c_str(), materials::to_string(target),
+  std::printf("wrote %s (%s, scene unit %s = %g mm)\n", printable(a.output).c_str(), materials::to_string(target),
               a.scene_unit.c_str(), mm_per_unit);
   std::printf("round trip (the target's parameters inverted back), mm^-1:\n");
   std::printf("  %-4s %-16s %14s %14s %10s\n", "ch", "coefficient", "lucent", "back", "diff %");
@@ -82,11 +82,14 @@ void run_materials(bool json) {
       std::snprintf(b, sizeof b, "%.3g %.3g %.3g", v[0], v[1], v[2]);
       return std::string(b);
     };
-    std::printf("%-12s %5.3g  %-26s %-26s %-20s %-20s  %s\n", name.c_str(), m.ior,
+    // The library's text is data: a control character in it would forge rows or drive the
+    // terminal.
+    std::printf("%-12s %5.3g  %-26s %-26s %-20s %-20s  %s\n", printable(name).c_str(), m.ior,
                 three(m.sigma_a).c_str(), three(m.sigma_s_reduced).c_str(), three(alpha).c_str(),
-                three(mfp).c_str(), source.c_str());
+                three(mfp).c_str(), printable(source).c_str());
   }
-  if (json) std::cout << list.dump(2) << '\n';
+  if (json)
+    std::cout << list.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
 }
 
 }  // namespace

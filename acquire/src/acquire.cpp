@@ -361,6 +361,24 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
                 " unmasked pixels in every channel within " + number(summary.radius_mm) +
                 " mm of the entry point (use fewer --bins or a larger --radius-mm)");
   }
+  // A calibrated sample cannot return more light than came in: integrated over the field, pi L per
+  // unit power is about the diffuse reflectance (exactly so for a Lambertian exit), at most 1. A
+  // sample 1.5 times brighter than that says the white reference is wrong (50 times darker than
+  // the sample gave sigma_a = 3.6e-112 with exit 0).
+  if (summary.calibrated) {
+    for (int c = 0; c < 3; ++c) {
+      double total = 0;
+      for (std::size_t i = 0; i < profile.radial.size(); ++i)
+        total += profile.radial.value[c][i] * std::numbers::pi *
+                 (profile.radial.r_outer_mm[i] * profile.radial.r_outer_mm[i] -
+                  profile.radial.r_inner_mm[i] * profile.radial.r_inner_mm[i]);
+      if (total > 1.5)
+        throw Error(capture_json.string() + ": field 'white_reference': the sample returns " +
+                    number(total, 3) + " times the light the white reference says reached it (" +
+                    "RGB"[c] + " channel): a white reference darker than the sample (another " +
+                    "beam power, exposure or gain?)");
+    }
+  }
   if (capture.incidence_polar_deg > 0) {
     profile.samples_2d =
         sample_2d_profile(hdr, bp, capture.pixel_pitch_mm, scale, summary.radius_mm);

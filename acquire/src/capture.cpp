@@ -110,6 +110,12 @@ ImageSet read_image_set(const json& doc, const std::string& prefix, const FieldR
                   std::to_string(b.exposure_s) + " s after " +
                   std::to_string(set.images.back().exposure_s) + " s)");
     }
+    // One picture is one exposure: the same file at two exposure times is a slip of the pen
+    // (merged, it would pass for a flat response).
+    for (std::size_t k = 0; k < set.images.size(); ++k)
+      if (set.images[k].path == b.path)
+        in.fail(field + ".path", "'" + b.path.string() + "' is already image " + std::to_string(k) +
+                                     ": each bracket is its own file");
     set.images.push_back(b);
   }
   return set;

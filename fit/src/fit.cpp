@@ -97,6 +97,16 @@ FitResult fit_profiles(const std::vector<ProfileData>& input, const FitOptions& 
   }
   std::optional<double> eta = options.ior;
   if (!eta) eta = data.front().eta;
+  // Inputs of one material share one index: two that say otherwise contradict each other (unless
+  // --ior says which).
+  if (!options.ior)
+    for (const ProfileData& d : data)
+      if (d.eta && eta && std::abs(*d.eta - *eta) > 1e-6) {
+        std::ostringstream m;
+        m << d.source << ": relative index " << *d.eta << ", but " << data.front().source
+          << " says " << *eta << ": inputs fitted jointly are one material (give --ior)";
+        throw Error(m.str());
+      }
   if (!eta && !options.fit_ior) {
     throw Error(
         "--ior: the relative index of refraction is required (the data does not carry one); "

@@ -96,7 +96,12 @@ ProfileData parse_profile_csv(std::string_view text, const std::string& source) 
     return value;
   };
   if (auto eta = meta_number("ior")) d.eta = *eta;
-  if (auto eta = meta_number("eta")) d.eta = *eta;
+  if (auto eta = meta_number("eta")) {
+    if (d.eta && std::abs(*d.eta - *eta) > 1e-9)
+      throw Error(source + ": comment fields ior= and eta= disagree (" + meta.at("ior") + " and " +
+                  meta.at("eta") + "): give one relative index");
+    d.eta = *eta;
+  }
   if (d.eta && !(*d.eta > 0 && *d.eta <= 4))
     throw Error(source + ": comment field ior/eta: expected a relative index in (0, 4]");
   if (auto it = meta.find("quantity"); it != meta.end()) {
@@ -254,6 +259,11 @@ ProfileData parse_profile_csv(std::string_view text, const std::string& source) 
                   format_number(r_inner) + ", " + format_number(r) + ", " +
                   format_number(r_outer));
     }
+    // Rows in order of radius, each once: a duplicated row would double its weight in silence.
+    if (!d.radial.r_mm.empty() && !(r > d.radial.r_mm.back()))
+      throw Error(where + "r_mm " + format_number(r) + " is not above the previous row's " +
+                  format_number(d.radial.r_mm.back()) +
+                  " (rows must rise in radius, each radius once)");
     d.radial.r_mm.push_back(r);
     d.radial.r_inner_mm.push_back(r_inner);
     d.radial.r_outer_mm.push_back(r_outer);

@@ -245,7 +245,7 @@ void warn(const std::string& line) {
       return;
     }
   }
-  std::fprintf(stderr, "%s\n", line.c_str());
+  std::fprintf(stderr, "%s\n", printable(line).c_str());
 }
 
 void check_output_folder(const fs::path& path) {

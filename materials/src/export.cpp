@@ -40,7 +40,10 @@ std::string mtlx_name(const std::string& s) {
 // A pbrt string literal holds no quote or newline.
 std::string pbrt_string(const std::string& s) {
   std::string out;
-  for (char ch : s) out += (ch == '"' || ch == '\n' || ch == '\r') ? '_' : ch;
+  // pbrt's strings end at '"' and take '\\' as an escape: neither, nor a control character, in a
+  // name (a name ending in '\\' escaped the closing quote).
+  for (char ch : s)
+    out += (ch == '"' || ch == '\\' || static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f) ? '_' : ch;
   return out;
 }
 
@@ -145,7 +148,7 @@ ExportResult to_mitsuba(const Material& m, double mm_per_unit) {
   const double radius = 10.0 / mm_per_unit;  // a 1 cm sphere
   std::ostringstream s;
   s << "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n"
-    << "<!-- lucent export of '" << xml_escape(m.name) << "' for Mitsuba 3: a homogeneous medium "
+    << "<!-- lucent export of '" << xml_comment(m.name) << "' for Mitsuba 3: a homogeneous medium "
     << "inside a smooth dielectric, on a sphere of 1 cm (radius " << num(radius)
     << " scene units); sigma_t is lucent's (mm^-1), scale " << num(mm_per_unit)
     << " makes it per scene unit. -->\n"
@@ -202,7 +205,7 @@ ExportResult to_materialx(const Material& m, double mm_per_unit, bool openpbr) {
   };
   std::ostringstream s;
   s << "<?xml version=\"1.0\"?>\n"
-    << "<!-- lucent export of '" << xml_escape(m.name) << "': subsurface colour = the standard "
+    << "<!-- lucent export of '" << xml_comment(m.name) << "': subsurface colour = the standard "
     << "dipole's total diffuse reflectance, radius = the diffuse mean free path 1 / sigma_tr per "
     << "channel, in scene units of " << num(mm_per_unit) << " mm. -->\n";
   if (!openpbr) {

@@ -456,6 +456,14 @@ void write_material(const std::filesystem::path& path, const Material& material)
     if (it != doc.end()) ordered[std::string(field)] = nlohmann::ordered_json(*it);
   }
   check_finite_json(ordered, path.string());
+  // What lucent writes it must be able to read back: the reader's own ranges hold on every output
+  // (a fit of profile values of 1e-320 wrote sigma_a = 2e46 mm^-1, past the reader's 1e6).
+  try {
+    (void)material_from_json(doc, path.string());
+  } catch (const Error& e) {
+    throw Error(path.string() + ": cannot write: the material would not read back (" +
+                std::string(e.what()) + ")");
+  }
   write_file_atomically(path, ordered.dump(2) + "\n");
 }
 

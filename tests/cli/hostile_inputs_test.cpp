@@ -293,6 +293,131 @@ TEST(Images, ALuminanceOnlyExrIsGrey) {
   fs::remove_all(dir);
 }
 
+// ---- impossible or contradictory physics --------------------------------------------------------
+
+// The world's capture (absolute paths) with `edit` applied, as c.json in the case folder.
+std::function<void(const fs::path&)> capture_edited(std::function<void(Json&)> edit) {
+  return edited_json("capture_abs.json", "c.json", std::move(edit));
+}
+
+// A radial CSV of these rows ("r,value,se" each), with these comment tokens.
+std::function<void(const fs::path&)> csv(std::string comments, std::string rows,
+                                         std::string name = "p.csv") {
+  return [=](const fs::path& dir) {
+    write_file(dir / name, "# quantity=exitance " + comments + "\nr_mm,R,se\n" + rows);
+  };
+}
+
+std::string rows_of(double value) {
+  std::string rows;
+  for (int i = 1; i <= 30; ++i) {
+    char line[96];
+    std::snprintf(line, sizeof line, "%g,%g,%g\n", 0.2 * i, value * std::exp(-0.3 * 0.2 * i) / (0.2 * i),
+                  0.02 * value * std::exp(-0.3 * 0.2 * i) / (0.2 * i));
+    rows += line;
+  }
+  return rows;
+}
+
+std::vector<BadCase> physics_cases() {
+  const std::string fit = "fit {dir}/p.csv -o {dir}/m.json";
+  const std::string acq = "acquire {dir}/c.json -o {dir}/out";
+  return {
+      {"ior_and_eta_disagree", csv("ior=1.3 eta=1.5", rows_of(0.1)), fit, "p.csv: comment fields ior= and eta= disagree"},
+      {"a_row_twice", csv("ior=1.3", "1,0.1,0.001\n1,0.1,0.001\n2,0.05,0.001\n"), fit,
+       "p.csv: line"},
+      {"rows_falling_in_radius", csv("ior=1.3", "2,0.05,0.001\n1,0.1,0.001\n3,0.02,0.001\n"), fit,
+       "not above the previous row"},
+      {"two_inputs_two_indices",
+       [](const fs::path& dir) {
+         csv("ior=1.3", rows_of(0.1), "a.csv")(dir);
+         csv("ior=1.5", rows_of(0.1), "b.csv")(dir);
+       },
+       "fit {dir}/a.csv {dir}/b.csv -o {dir}/m.json", "b.csv: relative index 1.5"},
+      {"values_at_the_edge_of_nothing", csv("ior=1.3", rows_of(1e-300)), fit, "m.json"},
+      {"one_image_at_two_exposures",
+       capture_edited([](Json& c) { c["images"][1]["path"] = c["images"][0]["path"]; }), acq,
+       "is already image 0"},
+      {"white_reference_fifty_times_darker",
+       capture_edited([](Json& c) {
+         for (auto& image : c["white_reference"]["images"])
+           image["exposure_s"] = image["exposure_s"].get<double>() * 50;
+       }),
+       acq, "field 'white_reference': the sample returns"},
+      {"simulate_exposure_acquire_refuses", nullptr,
+       "simulate --material marble --photons 1000 --size 16 -o {dir}/s --exposures 1e-12,1/60",
+       "--exposures"},
+      {"simulate_exposure_huge", nullptr,
+       "simulate --material marble --photons 1000 --size 16 -o {dir}/s --exposures 1/60,1e7",
+       "--exposures"},
+  };
+}
+
+class Physics : public ::testing::TestWithParam<BadCase> {};
+TEST_P(Physics, ImpossibleOrContradictoryInputsAreRefused) { expect_clean_refusal(GetParam()); }
+INSTANTIATE_TEST_SUITE_P(Table, Physics, ::testing::ValuesIn(physics_cases()),
+                         [](const auto& info) { return info.param.name; });
+
+// ---- injection: names are data --------------------------------------------------------------------
+
+// Each export of a material whose name holds what would break the target's syntax (an XML comment's
+// "--", a pbrt string's closing quote escaped by a trailing backslash, control characters): the
+// file stays well formed (the XML parses as one comment and one document element; pbrt's quotes
+// pair), and what lucent prints of the name has no raw control characters.
+TEST(Injection, NamesAreDataInEveryExportAndOnTheTerminal) {
+  const fs::path dir = scratch_dir("hostile-names");
+  nlohmann::json m = nlohmann::json::parse(read_bytes(fs::path(LUCENT_SOURCE_DIR) / "materials/library/marble.json"));
+  for (const std::string name : {std::string("a--b-"), std::string("end\\"), std::string("x\x1b[31m\ny"),
+                                 std::string("q\"uote<&>'")}) {
+    m["name"] = name;
+    write_file(dir / "m.json", m.dump());
+    for (const char* target : {"mitsuba", "materialx", "openpbr", "pbrt"}) {
+      const std::string ext = std::string(target) == "pbrt" ? ".pbrt" : std::string(target) == "mitsuba" ? ".xml" : ".mtlx";
+      const fs::path out = dir / (std::string("out") + ext);
+      const CommandResult r = run_lucent("export --material \"" + (dir / "m.json").string() +
+                                         "\" --to " + target + " -o \"" + out.string() + "\"");
+      ASSERT_EQ(r.exit_code, 0) << target << ": " << r.err;
+      for (const char ch : r.out + r.err)
+        EXPECT_FALSE(static_cast<unsigned char>(ch) < 0x20 && ch != '\n') << target << ": raw control character";
+      const std::string text = read_bytes(out);
+      if (ext != ".pbrt") {
+        // Inside every comment no "--", and no comment ends in "-".
+        for (std::size_t at = text.find("<!--"); at != std::string::npos; at = text.find("<!--", at + 4)) {
+          const std::size_t end = text.find("-->", at + 4);
+          ASSERT_NE(end, std::string::npos) << target;
+          const std::string body = text.substr(at + 4, end - at - 4);
+          EXPECT_EQ(body.find("--"), std::string::npos) << target << ": " << body;
+          EXPECT_NE(body.back(), '-') << target << ": " << body;
+        }
+        for (const char ch : text)
+          EXPECT_FALSE(static_cast<unsigned char>(ch) < 0x20 && ch != '\n' && ch != '\t' && ch != '\r') << target;
+      } else {
+        // Every line's quotes pair up, none escaped.
+        std::istringstream in(text);
+        for (std::string line; std::getline(in, line);) {
+          if (!line.empty() && line[0] == '#') continue;
+          EXPECT_EQ(std::count(line.begin(), line.end(), '"') % 2, 0) << line;
+          EXPECT_EQ(line.find('\\'), std::string::npos) << line;
+        }
+      }
+      fs::remove(out);
+    }
+  }
+  fs::remove_all(dir);
+}
+
+// An error naming a file whose name holds a newline and an escape stays one line, escapes shown.
+TEST(Injection, AnErrorNamingAHostileFileNameIsOneLine) {
+  const fs::path dir = scratch_dir("hostile-error-name");
+  const std::string name = (dir / "bad\nname\x1b[2J.json").string();
+  const CommandResult r = run_lucent("fit \"" + name + "\" --ior 1.3 -o \"" + (dir / "m.json").string() + "\"");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("\\x0a"), std::string::npos) << r.err;
+  fs::remove_all(dir);
+}
+
 // ---- the cache ----------------------------------------------------------------------------------
 
 // The cache's odd entries are never fatal: a FIFO named like a slice (it would block the run), a

@@ -24,4 +24,16 @@ inline std::string xml_escape(const std::string& s) {
   return out;
 }
 
+/// Text inside an XML comment: xml_escape, and no "--" (which ends a comment in XML 1.0) and no
+/// trailing "-" (a name "a--b" or "x-" broke the exports' comments).
+inline std::string xml_comment(const std::string& s) {
+  std::string out;
+  for (char ch : xml_escape(s)) {
+    if (ch == '-' && !out.empty() && out.back() == '-') out += ' ';
+    out += ch;
+  }
+  if (!out.empty() && out.back() == '-') out += ' ';
+  return out;
+}
+
 }  // namespace lucent
