@@ -4,7 +4,7 @@
 file(MAKE_DIRECTORY ${CORPUS})
 foreach(dir ${SEEDS})
   file(GLOB_RECURSE seeds "${dir}/*.json" "${dir}/*.csv" "${dir}/*.ply" "${dir}/*.obj"
-                            "${dir}/*.dng")
+                            "${dir}/*.dng" "${dir}/*.lut" "${dir}/*.exr" "${dir}/*.png")
   foreach(seed ${seeds})
     file(SIZE ${seed} bytes)
     if(bytes LESS 1048576)

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <ostream>
 #include <sstream>
@@ -58,8 +59,13 @@ int run_fit_bench(const FitBenchOptions& options, std::ostream& log) {
   // Scratch captures live in a temporary output folder that is never committed: files written
   // inside it appear at once (the command's transaction defers only the real outputs), and it is
   // removed on return, on an error and on SIGINT/SIGTERM.
-  const AtomicOutputDir scratch_dir(fs::temp_directory_path() /
-                                    ("lucent-bench-fit-" + std::to_string(::getpid())));
+  // TMPDIR naming a folder that is not there is the user's setting to fix, said in one line.
+  std::error_code ec;
+  const fs::path tmp = fs::temp_directory_path(ec);
+  if (ec || !fs::is_directory(tmp, ec))
+    throw Error("TMPDIR: " + std::string(std::getenv("TMPDIR") ? std::getenv("TMPDIR") : "") +
+                ": not a folder lucent can write scratch captures into (set TMPDIR to one)");
+  const AtomicOutputDir scratch_dir(tmp / ("lucent-bench-fit-" + std::to_string(::getpid())));
   const fs::path& scratch = scratch_dir.temporary();
 
   std::vector<BenchCase> cases;

@@ -63,6 +63,15 @@ std::string temporary_suffix() {
          std::to_string(g_counter.fetch_add(1));
 }
 
+// "." + name + the temporary suffix + extra, the name cut so that the whole stays within a file
+// name's 255 bytes (a legal 249-byte output was refused: its temporary's name was too long).
+std::string temporary_name(const std::string& name, const std::string& extra = "") {
+  const std::string suffix = temporary_suffix();
+  constexpr std::size_t kNameMax = 255;
+  const std::size_t room = kNameMax - 1 - suffix.size() - extra.size();
+  return "." + (name.size() > room ? name.substr(0, room) : name) + suffix + extra;
+}
+
 fs::path canonical_or_self(const fs::path& p) {
   std::error_code ec;
   fs::path c = fs::weakly_canonical(p, ec);
@@ -165,8 +174,7 @@ void finish(const fs::path& temporary, const fs::path& target, bool folder) {
   }
   std::error_code ec;
   if (folder && fs::exists(target)) {
-    const fs::path backup = folder_of(target) / ("." + target.filename().string() +
-                                                 temporary_suffix() + ".old");
+    const fs::path backup = folder_of(target) / temporary_name(target.filename().string(), ".old");
     fs::rename(target, backup, ec);
     if (!ec) {
       fs::rename(temporary, target, ec);
@@ -292,7 +300,7 @@ void write_file_atomically(const fs::path& path, std::string_view content, bool 
   if (cache_writes == 0) check_not_an_input(path);
   sweep_dead_temporaries(folder_of(path));
   const fs::path temporary =
-      folder_of(path) / ("." + path.filename().string() + temporary_suffix());
+      folder_of(path) / temporary_name(path.filename().string());
 
   // POSIX calls rather than std::ofstream: a stream only reports "failed", while the user needs the
   // reason (no such folder, permission denied, disk full). O_EXCL: never reuse someone else's file.
@@ -349,8 +357,8 @@ AtomicOutputPath::AtomicOutputPath(fs::path target) : target_(std::move(target))
   sweep_dead_temporaries(folder);
   // A hidden name (leading '.') so that a crash leaves nothing that looks like a result; the
   // extension stays last so that writers choosing the format from the name still see it.
-  temporary_ = target_.parent_path() / ("." + target_.stem().string() + temporary_suffix() +
-                                        target_.extension().string());
+  temporary_ = target_.parent_path() /
+               temporary_name(target_.stem().string(), target_.extension().string());
   track(temporary_, false);
 }
 
@@ -395,7 +403,7 @@ AtomicOutputDir::AtomicOutputDir(fs::path target) : target_(std::move(target)) {
     }
   }
   sweep_dead_temporaries(parent);
-  temporary_ = parent / ("." + target_.filename().string() + temporary_suffix());
+  temporary_ = parent / temporary_name(target_.filename().string());
   std::error_code ec;
   fs::create_directory(temporary_, ec);
   if (ec) throw Error(target_.string() + ": cannot write: " + ec.message());
@@ -474,7 +482,7 @@ void commit_pending_outputs() {
     fs::path backup;
     if (fs::exists(fs::symlink_status(d.target))) {
       backup = folder_of(d.target) /
-               ("." + d.target.filename().string() + temporary_suffix() + ".old");
+               temporary_name(d.target.filename().string(), ".old");
       fs::rename(d.target, backup, ec);
     }
     if (!ec) fs::rename(d.temporary, d.target, ec);

@@ -347,26 +347,28 @@ T whole_number(const json& v, const std::string& src, const char* name) {
                                 : static_cast<T>(v.get<std::int64_t>());
 }
 
-TransportTable read_transport_table_unchecked(const std::filesystem::path& path);
+TransportTable parse_unchecked(const std::string& file, const std::string& src);
 
 }  // namespace
 
-TransportTable read_transport_table(const std::filesystem::path& path) {
+TransportTable parse_transport_table(const std::string& bytes, const std::string& source) {
   try {
-    return read_transport_table_unchecked(path);
+    return parse_unchecked(bytes, source);
   } catch (const json::exception& e) {
-    throw Error(path.string() + ": not a valid lucent-transport-table header (" +
-                std::string(e.what()) + ")");
+    throw Error(source + ": not a valid lucent-transport-table header (" + std::string(e.what()) +
+                ")");
   }
+}
+
+TransportTable read_transport_table(const std::filesystem::path& path) {
+  // The bounded reading path (json_file.h): a regular file larger than the limit is refused by its
+  // size before a byte is read, anything else stops at the limit.
+  return parse_transport_table(read_input_file(path, kMaxTableBytes), path.string());
 }
 
 namespace {
 
-TransportTable read_transport_table_unchecked(const std::filesystem::path& path) {
-  const std::string src = path.string();
-  // The bounded reading path (json_file.h): a regular file larger than the limit is refused by its
-  // size before a byte is read, anything else stops at the limit.
-  const std::string file = read_input_file(path, kMaxTableBytes);
+TransportTable parse_unchecked(const std::string& file, const std::string& src) {
   const std::size_t newline = file.find('\n');
   if (newline == std::string::npos || newline > kMaxHeaderBytes)
     throw Error(src + ": not a lucent-transport-table (no header line)");
@@ -427,12 +429,12 @@ TransportTable read_transport_table_unchecked(const std::filesystem::path& path)
                  t.grid.rho_max / t.grid.rho_min <= 1e12 && t.grid.rho_per_decade >= 1 &&
                  t.grid.rho_per_decade <= 200 && t.groups >= 2 && t.groups <= 1 << 20 &&
                  t.grid.phi_bins >= 1 && t.grid.phi_bins <= 360 && t.grid.rho_bins() >= 2 &&
-                 std::isfinite(t.max_path) && t.max_path > 0;
+                 std::isfinite(t.max_path) && t.max_path >= 0;
   for (std::size_t k = 1; grid_ok && k < t.grid.u.size(); ++k)
     grid_ok = t.grid.u[k] > t.grid.u[k - 1] && t.grid.u[k] < 1;
   if (!grid_ok)
     throw Error(src + ": grid: expected rising u nodes in [0, 1), a finite rho range of at least 2 "
-                      "bins, 1..360 phi_bins, 2 or more groups and a finite max_path");
+                      "bins, 1..360 phi_bins, 2 or more groups and a finite max_path >= 0");
   if (t.slice_axes.empty()) throw Error(src + ": slices: expected at least one");
   for (const auto& a : t.slice_axes)
     if (!(a[0] >= 1 && a[0] <= 2.5 && a[1] >= 0 && a[1] < 1 && a[2] >= 1 && a[3] >= 0 &&

@@ -216,8 +216,10 @@ void Viewer::run_script_step() {
     quit_ = true;
   } else if (a.verb == "screenshot") {
     screenshot_path_ = a.args[0];  // taken in frame(), after drawing
+    screenshot_scripted_ = true;
   } else if (a.verb == "screenshot-panel") {
     panel_screenshot_path_ = a.args[0];  // with the panel on it
+    screenshot_scripted_ = true;
   } else if (a.verb == "panel") {
     show_ui_ = a.args[0] == "on";
   } else if (a.verb == "difference") {
@@ -236,7 +238,10 @@ void Viewer::handle_keys() {
     if (key == GLFW_KEY_L) fur_lobe_ = !fur_lobe_;  // fur: the seed's rotating lobe light
     if (key == GLFW_KEY_LEFT_BRACKET) scale_selected_light(1 / 1.25f);  // an area light's size
     if (key == GLFW_KEY_RIGHT_BRACKET) scale_selected_light(1.25f);
-    if (key == GLFW_KEY_S) screenshot_path_ = next_screenshot_path();  // taken after drawing
+    if (key == GLFW_KEY_S) {
+      screenshot_path_ = next_screenshot_path();  // taken after drawing
+      screenshot_scripted_ = false;
+    }
   }
 }
 
@@ -467,6 +472,9 @@ void Viewer::screenshot(const std::filesystem::path& path) {
                 maps_ ? maps_->accumulated_frames() : 0, settings_.frames);
     std::fflush(stdout);
   } catch (const Error& e) {
+    // A script asked for it: the run fails with it (a failed screenshot exited 0); a key press
+    // only says so on the panel and stderr.
+    if (std::exchange(screenshot_scripted_, false)) throw;
     message_ = e.what();
     std::fprintf(stderr, "view: %s\n", e.what());
   }

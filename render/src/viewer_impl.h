@@ -39,59 +39,9 @@
 
 #include "lucent/render/image_compare.h"
 #include "lucent/render/viewer.h"
+#include "viewer_script.h"
 
 namespace lucent::render::viewer_detail {
-
-// ---------------------------------------------------------------------------------------------
-// The script: one action per frame.
-
-struct ScriptAction {
-  std::string verb;
-  std::vector<std::string> args;
-};
-
-inline std::vector<ScriptAction> parse_script(const std::string& text) {
-  std::vector<ScriptAction> actions;
-  std::stringstream all(text);
-  std::string item;
-  while (std::getline(all, item, ';')) {
-    std::stringstream words(item);
-    ScriptAction action;
-    if (!(words >> action.verb)) continue;
-    for (std::string w; words >> w;) action.args.push_back(w);
-    const std::string& v = action.verb;
-    const std::size_t n = action.args.size();
-    const bool ok = ((v == "orbit" || v == "light" || v == "set") && n == 2) ||
-                    ((v == "zoom" || v == "wait" || v == "sleep" || v == "screenshot" ||
-                      v == "screenshot-panel") &&
-                     n == 1) ||
-                    (v == "key" && n == 1 && action.args[0].size() == 1 &&
-                     std::isalpha(static_cast<unsigned char>(action.args[0][0]))) ||
-                    ((v == "restart" || v == "settle" || v == "quit") && n == 0) ||
-                    ((v == "panel" || v == "difference") && n == 1 &&
-                     (action.args[0] == "on" || action.args[0] == "off"));
-    if (!ok) {
-      const auto first = item.find_first_not_of(' ');
-      const auto last = item.find_last_not_of(' ');
-      throw Error("--script: '" + item.substr(first, last - first + 1) +
-                  "': expected orbit DX DY, light DX DY, zoom STEPS, set NAME VALUE, key LETTER, "
-                  "wait FRAMES, sleep SECONDS, settle, screenshot FILE.png, screenshot-panel "
-                  "FILE.png, panel on|off, "
-                  "difference on|off, restart or quit");
-    }
-    actions.push_back(std::move(action));
-  }
-  return actions;
-}
-
-inline float parse_float(const std::string& text, const std::string& what) {
-  char* end = nullptr;
-  const float v = std::strtof(text.c_str(), &end);
-  if (text.empty() || *end != '\0' || !std::isfinite(v)) {
-    throw Error("--script: " + what + ": expected a number, got '" + text + "'");
-  }
-  return v;
-}
 
 // ---------------------------------------------------------------------------------------------
 // The CPU reference on a worker thread: one pass after another (new samples each), summed until the
@@ -305,6 +255,7 @@ class Viewer {
   bool settling_ = false;
   static constexpr double kSettleTimeout = 300;  // s
   std::filesystem::path screenshot_path_, panel_screenshot_path_;
+  bool screenshot_scripted_ = false;  // a script's screenshot that fails ends the run with its error
   int wait_frames_ = 0;
   bool quit_ = false;
   bool show_ui_ = true;

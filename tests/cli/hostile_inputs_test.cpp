@@ -418,6 +418,91 @@ TEST(Injection, AnErrorNamingAHostileFileNameIsOneLine) {
   fs::remove_all(dir);
 }
 
+// ---- merge ----------------------------------------------------------------------------------------
+
+// A shard summary: rows with these indices, of a manifest of `count` rows fitted with `options`.
+std::string summary(const std::string& count, std::vector<int> rows, const std::string& options,
+                    bool with_run = true) {
+  std::string r;
+  for (const int i : rows)
+    r += std::string(r.empty() ? "" : ",") + "{\"index\": " + std::to_string(i) +
+         ", \"input\": \"p.json\", \"output\": \"o" + std::to_string(i) +
+         ".json\", \"status\": \"failed\", \"error\": \"x\"}";
+  return "{\"format\": \"lucent-batch-summary\", \"version\": 1, \"manifest\": \"m.csv\", "
+         "\"manifest_rows\": " + count + ", " +
+         (with_run ? "\"run\": {\"manifest_fnv1a\": \"0\", \"options\": " + options + "}, " : "") +
+         "\"rows\": [" + r + "]}";
+}
+
+std::function<void(const fs::path&)> shards(std::string a, std::string b) {
+  return [=](const fs::path& dir) {
+    write_file(dir / "a.json", a);
+    write_file(dir / "b.json", b);
+  };
+}
+
+std::vector<BadCase> merge_cases() {
+  const std::string merge = "merge {dir}/a.json {dir}/b.json -o {dir}/all.json";
+  const std::string same = "{\"model\": \"auto\"}";
+  return {
+      {"other_options", shards(summary("2", {0}, same), summary("2", {1}, "{\"model\": \"dipole\"}")),
+       merge, "b.json: run: fitted with other options"},
+      {"claims_1e8_rows", shards(summary("100000000", {0}, same), summary("100000000", {1}, same)),
+       merge, "a.json: manifest_rows: 100000000 rows claimed, the shards hold 2"},
+      {"claims_1e19_rows",
+       shards(summary("10000000000000000000", {0}, same), summary("10000000000000000000", {1}, same)),
+       merge, "manifest_rows"},
+      {"claims_fewer_rows", shards(summary("1", {0}, same), summary("1", {1}, same)), merge,
+       "manifest_rows"},
+      {"a_row_twice", shards(summary("2", {0}, same), summary("2", {0}, same)), merge,
+       "b.json: rows: row 0 also in"},
+      {"no_run", shards(summary("2", {0}, same, false), summary("2", {1}, same, false)), merge,
+       "a.json: field 'run'"},
+      {"other_manifest",
+       shards(summary("2", {0}, same),
+              replace_all(summary("2", {1}, same), "\"m.csv\"", "\"n.csv\"")),
+       merge, "b.json: manifest"},
+      {"not_a_summary", shards("{\"format\": \"x\"}", summary("2", {1}, same)), merge, "a.json"},
+      {"rows_not_an_array",
+       shards(replace_all(summary("2", {0}, same), "\"rows\": [", "\"rows\": {\"x\": ["), summary("2", {1}, same)),
+       merge, "a.json"},
+      {"index_outside", shards(summary("2", {0}, same), summary("2", {7}, same)), merge,
+       "b.json: rows: an index outside"},
+      {"negative_count", shards(summary("-2", {0}, same), summary("-2", {1}, same)), merge,
+       "a.json: field 'manifest_rows'"},
+      {"text_not_json", shards("rows: 2", summary("2", {1}, same)), merge, "a.json"},
+  };
+}
+
+class MergeSummaries : public ::testing::TestWithParam<BadCase> {};
+TEST_P(MergeSummaries, AreRefusedNamingTheShard) { expect_clean_refusal(GetParam()); }
+INSTANTIATE_TEST_SUITE_P(Table, MergeSummaries, ::testing::ValuesIn(merge_cases()),
+                         [](const auto& info) { return info.param.name; });
+
+// ---- smaller -------------------------------------------------------------------------------------
+
+// A legal output name of 250 bytes is written (its temporary's name, which adds a dot and a
+// suffix, was over the 255-byte limit and the output refused); a mesh of zero-area triangles is
+// refused (it rendered black with exit 0).
+TEST(Smaller, ALongLegalOutputNameIsWrittenAndAFlatMeshRefused) {
+  const fs::path dir = scratch_dir("hostile-smaller");
+  const fs::path out = dir / (std::string(245, 'n') + ".json");
+  const CommandResult r =
+      run_lucent("fit \"" + (world() / "acq/profile.json").string() + "\" --quality fast -q -o \"" +
+                 out.string() + "\"");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(out));
+  write_file(dir / "flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nf 1 2 3\nf 2 3 4\n");
+  const CommandResult flat = run_lucent(
+      "render --material marble --mesh \"" + (dir / "flat.obj").string() +
+      "\" --technique reference --size 8x8 --samples-pixel 1 -o \"" + (dir / "r.exr").string() + "\"");
+  EXPECT_NE(flat.exit_code, 0);
+  EXPECT_NE(flat.err.find("zero area"), std::string::npos) << flat.err;
+  EXPECT_EQ(std::count(flat.err.begin(), flat.err.end(), '\n'), 1) << flat.err;
+  EXPECT_FALSE(fs::exists(dir / "r.exr"));
+  fs::remove_all(dir);
+}
+
 // ---- the cache ----------------------------------------------------------------------------------
 
 // The cache's odd entries are never fatal: a FIFO named like a slice (it would block the run), a

@@ -121,6 +121,8 @@ struct TransportTable {
 
 /// Reads a table (finished or partial). Throws lucent::Error naming the file and the field.
 TransportTable read_transport_table(const std::filesystem::path& path);
+/// The same from a file's bytes (`source` names it in errors): the fuzz target's entry.
+TransportTable parse_transport_table(const std::string& bytes, const std::string& source);
 /// Writes atomically.
 void write_transport_table(const TransportTable& table, const std::filesystem::path& path);
 
