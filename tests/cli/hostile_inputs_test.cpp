@@ -347,6 +347,22 @@ std::vector<BadCase> physics_cases() {
       {"simulate_exposure_acquire_refuses", nullptr,
        "simulate --material marble --photons 1000 --size 16 -o {dir}/s --exposures 1e-12,1/60",
        "--exposures"},
+      {"capture_ior_ten", capture_edited([](Json& c) { c["ior"] = 10; }), acq, "field 'ior'"},
+      {"capture_thickness_negative", capture_edited([](Json& c) { c["thickness_mm"] = -1; }), acq,
+       "field 'thickness_mm'"},
+      {"capture_far_side_without_thickness",
+       capture_edited([](Json& c) { c["side"] = "transmitted"; }), acq, "field 'side'"},
+      {"capture_side_misspelt",
+       capture_edited([](Json& c) {
+         c["thickness_mm"] = 2;
+         c["side"] = "transmited";
+       }),
+       acq, "field 'side'"},
+      {"white_reflectance_above_one",
+       capture_edited([](Json& c) { c["white_reference"]["reflectance"] = 1.5; }), acq,
+       "white_reference.reflectance"},
+      {"csv_thickness_zero", csv("ior=1.3 thickness_mm=0", rows_of(0.1)), fit, "thickness_mm"},
+      {"csv_ior_negative", csv("ior=-1.3", rows_of(0.1)), fit, "p.csv"},
       {"simulate_exposure_huge", nullptr,
        "simulate --material marble --photons 1000 --size 16 -o {dir}/s --exposures 1/60,1e7",
        "--exposures"},
@@ -471,6 +487,16 @@ std::vector<BadCase> merge_cases() {
       {"negative_count", shards(summary("-2", {0}, same), summary("-2", {1}, same)), merge,
        "a.json: field 'manifest_rows'"},
       {"text_not_json", shards("rows: 2", summary("2", {1}, same)), merge, "a.json"},
+      {"count_a_string", shards(summary("\"2\"", {0}, same), summary("\"2\"", {1}, same)), merge,
+       "a.json: field 'manifest_rows'"},
+      {"index_a_string",
+       shards(replace_all(summary("2", {0}, same), "\"index\": 0", "\"index\": \"0\""),
+              summary("2", {1}, same)),
+       merge, "a.json: rows"},
+      {"row_not_an_object",
+       shards(replace_all(summary("2", {0}, same), "\"rows\": [{", "\"rows\": [7, {"),
+              summary("2", {1}, same)),
+       merge, "the shards hold 3"},
   };
 }
 
