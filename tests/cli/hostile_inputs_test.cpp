@@ -434,6 +434,21 @@ TEST(Injection, AnErrorNamingAHostileFileNameIsOneLine) {
   fs::remove_all(dir);
 }
 
+// A name that is not UTF-8 (nlohmann refuses to write it into JSON) is one clean error, not an
+// internal one, and nothing is written.
+TEST(Injection, ANameThatIsNotUtf8IsOneCleanError) {
+  const fs::path dir = scratch_dir("hostile-utf8");
+  const CommandResult r = run_lucent("fit \"" + (world() / "acq/profile.json").string() +
+                                     "\" --quality fast -q --name \"$(printf 'bad\\377\\376name')\" -o \"" +
+                                     (dir / "m.json").string() + "\"");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("not valid UTF-8"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "m.json"));
+  fs::remove_all(dir);
+}
+
 // ---- merge ----------------------------------------------------------------------------------------
 
 // A shard summary: rows with these indices, of a manifest of `count` rows fitted with `options`.
