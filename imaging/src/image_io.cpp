@@ -65,7 +65,16 @@ class QuietStderr {
   int saved_ = -1;
 };
 
-cv::Mat decode_image_quietly(const std::filesystem::path& path, int flags) {
+// The formats lucent reads through OpenCV, by their first bytes: PNG and TIFF brackets, Radiance
+// .hdr maps. Nothing else reaches OpenCV, which sniffs the bytes and hands them to whatever codec
+// claims them (a fuzzed "PNG" went to the DICOM reader, which aborts on bad input).
+bool known_signature(const std::string& b, bool radiance) {
+  const auto starts = [&](const char* s, std::size_t n) { return b.size() >= n && b.compare(0, n, s, n) == 0; };
+  if (radiance) return starts("#?RADIANCE", 10) || starts("#?RGBE", 6);
+  return starts("\x89PNG\r\n\x1a\n", 8) || starts("II*\0", 4) || starts("MM\0*", 4);
+}
+
+cv::Mat decode_image_quietly(const std::filesystem::path& path, int flags, bool radiance) {
   static const bool silenced = [] {
     cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
     return true;
@@ -73,6 +82,8 @@ cv::Mat decode_image_quietly(const std::filesystem::path& path, int flags) {
   (void)silenced;
   // Read by lucent (bounded, recorded as an input), decoded from memory by OpenCV.
   const std::string bytes = read_input_file(path, std::size_t(1) << 30);
+  if (!known_signature(bytes, radiance))
+    return cv::Mat();  // the callers name the file and what they expected
   // A PNG's size is in its header: judged before the decoder allocates for it (a 1.2 MB PNG of
   // 20000^2 was decoded whole, 1.2 GB, before the check below).
   if (bytes.size() >= 24 && bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0 &&
@@ -105,7 +116,7 @@ cv::Mat decode_image_quietly(const std::filesystem::path& path, int flags) {
 
 ImageRgb read_radiance_hdr(const std::filesystem::path& path) {
   if (!std::filesystem::exists(path)) throw Error(path.string() + ": no such image file");
-  const cv::Mat bgr = decode_image_quietly(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR);
+  const cv::Mat bgr = decode_image_quietly(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR, true);
   if (bgr.empty()) throw Error(path.string() + ": not a readable Radiance .hdr image");
   if (bgr.depth() != CV_32F || bgr.channels() != 3) {
     throw Error(path.string() + ": not a floating-point (HDR) image");
@@ -223,7 +234,7 @@ void write_exr(const std::filesystem::path& path, const ImageRgb& image,
 RawImage read_raw_image(const std::filesystem::path& path) {
   if (is_camera_raw_path(path)) return read_camera_raw(path);
   if (!std::filesystem::exists(path)) throw Error(path.string() + ": no such image file");
-  const cv::Mat mat = decode_image_quietly(path, cv::IMREAD_UNCHANGED);
+  const cv::Mat mat = decode_image_quietly(path, cv::IMREAD_UNCHANGED, false);
   if (mat.empty())
     throw Error(path.string() +
                 ": cannot read as an image (expected PNG, TIFF or a camera RAW file)");

@@ -188,6 +188,13 @@ std::vector<BadCase> bracket_cases() {
       {"bracket_jpeg_bytes_as_png", capture_with("image", bytes_at("\xff\xd8\xff\xe0garbage")),
        args, "img.png"},
       {"capture_hdr_text", capture_hdr(bytes_at("not an exr")), args, "h.exr"},
+      // A fuzz finding (fuzz_image_headers): bytes OpenCV sniffed as DICOM, whose reader aborted.
+      {"bracket_fuzzed_dicom_abort",
+       capture_with("image",
+                    [](const fs::path& p) {
+                      fs::copy_file(fs::path(LUCENT_SOURCE_DIR) / "tests/cli/data/fuzz_image_gdcm_abort.png", p);
+                    }),
+       args, "img.png"},
       {"bracket_png_header_20000", capture_with("image", bytes_at(png_claiming(20000, 20000))),
        args, "20000 x 20000"},
       {"bracket_png_header_wide", capture_with("image", bytes_at(png_claiming(40000, 2))), args,
