@@ -12,6 +12,7 @@
 #include <cstdlib>
 
 #include "bad_input.h"
+#include "lucent/materials/transport_table.h"
 
 namespace lucent::testing {
 namespace {
@@ -546,47 +547,121 @@ TEST(Smaller, ALongLegalOutputNameIsWrittenAndAFlatMeshRefused) {
 
 // ---- the cache ----------------------------------------------------------------------------------
 
-// The cache's odd entries are never fatal: a FIFO named like a slice (it would block the run), a
-// symlink loop as the cache folder, a corrupt slice (rebuilt and replaced). The fit at a g the
-// shipped table lacks builds a slice (1e4 photons: a second or two) and exits 0 with a warning.
-TEST(Cache, OddEntriesAreSkippedWithAWarningAndACorruptOneIsReplaced) {
-  const fs::path dir = scratch_dir("hostile-cache");
-  const auto q = [](const fs::path& p) { return "\"" + p.string() + "\""; };
-  const std::string fit = "fit " + q(world() / "acq/profile.json") +
-                          " --g 0.95 --table-photons 10000 -q -o ";
-  const auto with_cache = [&](const fs::path& cache, const std::string& out) {
-    ::setenv("LUCENT_CACHE_DIR", cache.c_str(), 1);
-    const CommandResult r = run_lucent(fit + q(dir / out));  // a FIFO opened would hang: ctest's timeout
-    ::unsetenv("LUCENT_CACHE_DIR");
-    return r;
+// The cache's odd entries are never fatal and never block: every case runs a fit at a g the shipped
+// table lacks (it looks for the slice in the cache, then builds it at 1e4 photons: a second or two)
+// and must exit 0, with a warning where the entry was odd, and leave a readable slice where it
+// replaced one.
+struct CacheCase {
+  std::string name;
+  /// Prepares the cache folder `cache` (not yet made) whose slice is called `slice`.
+  std::function<void(const fs::path& cache, const std::string& slice)> setup;
+  bool warned = true;     // a warning on stderr
+  bool replaced = false;  // afterwards the slice is a regular file lucent reads
+};
+void PrintTo(const CacheCase& c, std::ostream* os) { *os << c.name; }
+
+const std::string& fit_at_g095() {
+  static const std::string fit = "fit \"" + (world() / "acq/profile.json").string() +
+                                 "\" --g 0.95 --table-photons 10000 --quality fast -q -o ";
+  return fit;
+}
+
+CommandResult fit_with_cache(const fs::path& cache, const fs::path& out) {
+  ::setenv("LUCENT_CACHE_DIR", cache.c_str(), 1);
+  // A FIFO opened would hang: ctest's timeout ends it.
+  const CommandResult r = run_lucent(fit_at_g095() + "\"" + out.string() + "\"");
+  ::unsetenv("LUCENT_CACHE_DIR");
+  return r;
+}
+
+// The slice's file name and a good copy of it, from one build in a fresh cache.
+const std::pair<std::string, std::string>& good_slice() {
+  static const std::pair<std::string, std::string> slice = [] {
+    const fs::path dir = scratch_dir("hostile-cache-learn");
+    const CommandResult r = fit_with_cache(dir / "cache", dir / "m.json");
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    std::pair<std::string, std::string> found;
+    for (const auto& e : fs::directory_iterator(dir / "cache"))
+      found = {e.path().filename().string(), read_bytes(e.path())};
+    return found;
+  }();
+  return slice;
+}
+
+std::vector<CacheCase> cache_cases() {
+  using P = const fs::path&;
+  using S = const std::string&;
+  const auto made = [](P c) { fs::create_directories(c); };
+  return {
+      {"fifo_under_the_slices_name", [=](P c, S n) { made(c), ::mkfifo((c / n).c_str(), 0644); }, true, true},
+      {"fifo_named_like_another_slice",
+       [=](P c, S n) { made(c), ::mkfifo((c / replace_all(n, "n10000", "n20000")).c_str(), 0644); }, false, false},
+      {"device_under_the_slices_name", [=](P c, S n) { made(c), fs::create_symlink("/dev/zero", c / n); }, true, true},
+      {"dangling_link", [=](P c, S n) { made(c), fs::create_symlink(c / "nowhere.lut", c / n); }, true, true},
+      {"folder_under_the_slices_name", [=](P c, S n) { fs::create_directories(c / n); }, true, false},
+      {"cache_folder_a_loop", [](P c, S) { fs::create_directories(c.parent_path()), fs::create_directory_symlink(c, c); }, true, false},
+      {"cache_folder_a_file", [](P c, S) { fs::create_directories(c.parent_path()), write_file(c, "a file"); }, true, false},
+      {"cache_folder_under_a_file",
+       [](P c, S) { fs::create_directories(c.parent_path().parent_path()), write_file(c.parent_path(), "x"); },
+       true, false},
+      {"garbage_entry", [=](P c, S n) { made(c), write_file(c / n, "garbage\n"); }, true, true},
+      {"empty_entry", [=](P c, S n) { made(c), write_file(c / n, ""); }, true, true},
+      {"truncated_entry",
+       [=](P c, S n) { made(c), write_file(c / n, good_slice().second.substr(0, good_slice().second.size() / 2)); },
+       true, true},
+      {"entry_with_zero_radius_bins",
+       [=](P c, S n) {
+         made(c);
+         const std::string& b = good_slice().second;
+         const std::size_t nl = b.find('\n');
+         nlohmann::json h = nlohmann::json::parse(b.substr(0, nl));
+         h["grid"]["rho_max"] = h["grid"]["rho_min"].get<double>() * 1.0001;
+         write_file(c / n, h.dump() + "\n" + b.substr(nl + 1));
+       },
+       true, true},
+      {"entry_of_another_eta",
+       [=](P c, S n) {
+         made(c);
+         std::string b = good_slice().second;
+         const std::size_t nl = b.find('\n');
+         nlohmann::json h = nlohmann::json::parse(b.substr(0, nl));
+         h["slices"][0]["eta"] = 2.2;
+         write_file(c / n, h.dump() + "\n" + b.substr(nl + 1));
+       },
+       false, true},
+      {"good_entry_through_a_link",
+       [=](P c, S n) {
+         made(c);
+         write_file(c.parent_path() / "elsewhere.lut", good_slice().second);
+         fs::create_symlink(c.parent_path() / "elsewhere.lut", c / n);
+       },
+       false, true},
+      {"good_entry", [=](P c, S n) { made(c), write_file(c / n, good_slice().second); }, false, true},
   };
-  // A FIFO under every name a slice might have: the listing and the exact name alike.
-  fs::create_directories(dir / "fifo");
-  const CommandResult first = with_cache(dir / "fifo", "a.json");  // learn the slice's name
-  ASSERT_EQ(first.exit_code, 0) << first.err;
-  std::string slice;
-  for (const auto& e : fs::directory_iterator(dir / "fifo")) slice = e.path().filename().string();
+}
+
+class CacheEntries : public ::testing::TestWithParam<CacheCase> {};
+TEST_P(CacheEntries, AreNeverFatalAndOddOnesAreReplaced) {
+  const CacheCase& c = GetParam();
+  const std::string slice = good_slice().first;
   ASSERT_FALSE(slice.empty());
-  fs::remove(dir / "fifo" / slice);
-  ASSERT_EQ(::mkfifo((dir / "fifo" / slice).c_str(), 0644), 0);
-  const CommandResult fifo = with_cache(dir / "fifo", "b.json");
-  EXPECT_EQ(fifo.exit_code, 0) << fifo.err;  // not 124: the FIFO was not opened
-  EXPECT_NE(fifo.err.find("not a regular file"), std::string::npos) << fifo.err;
-  EXPECT_TRUE(fs::exists(dir / "b.json"));
-  // A loop as the cache folder.
-  fs::create_directory_symlink(dir / "loop", dir / "loop");
-  const CommandResult loop = with_cache(dir / "loop", "c.json");
-  EXPECT_EQ(loop.exit_code, 0) << loop.err;
-  EXPECT_EQ(loop.err.find("internal error"), std::string::npos) << loop.err;
-  EXPECT_NE(loop.err.find("warning"), std::string::npos) << loop.err;
-  // A corrupt slice: rebuilt, and the cache holds the rebuilt one.
-  fs::create_directories(dir / "corrupt");
-  write_file(dir / "corrupt" / slice, "garbage\n");
-  const CommandResult corrupt = with_cache(dir / "corrupt", "d.json");
-  EXPECT_EQ(corrupt.exit_code, 0) << corrupt.err;
-  EXPECT_NE(read_bytes(dir / "corrupt" / slice), "garbage\n");
+  const fs::path dir = scratch_dir("hostile-cache-" + c.name);
+  const fs::path cache = dir / "sub" / "cache";
+  c.setup(cache, slice);
+  const CommandResult r = fit_with_cache(cache, dir / "m.json");
+  EXPECT_EQ(r.exit_code, 0) << c.name << ": " << r.err;
+  EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::exists(dir / "m.json")) << c.name;
+  if (c.warned) EXPECT_NE(r.err.find("warning"), std::string::npos) << c.name << ": " << r.err;
+  if (c.replaced) {
+    std::error_code ec;
+    EXPECT_TRUE(fs::is_regular_file(cache / slice, ec)) << c.name;
+    EXPECT_NO_THROW((void)lucent::materials::read_transport_table(cache / slice)) << c.name;
+  }
   fs::remove_all(dir);
 }
+INSTANTIATE_TEST_SUITE_P(Table, CacheEntries, ::testing::ValuesIn(cache_cases()),
+                         [](const auto& info) { return info.param.name; });
 
 }  // namespace
 }  // namespace lucent::testing
