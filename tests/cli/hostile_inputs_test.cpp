@@ -378,53 +378,71 @@ INSTANTIATE_TEST_SUITE_P(Table, Physics, ::testing::ValuesIn(physics_cases()),
 // ---- injection: names are data --------------------------------------------------------------------
 
 // Each export of a material whose name holds what would break the target's syntax (an XML comment's
-// "--", a pbrt string's closing quote escaped by a trailing backslash, control characters): the
-// file stays well formed (the XML parses as one comment and one document element; pbrt's quotes
-// pair), and what lucent prints of the name has no raw control characters.
-TEST(Injection, NamesAreDataInEveryExportAndOnTheTerminal) {
-  const fs::path dir = scratch_dir("hostile-names");
-  nlohmann::json m = nlohmann::json::parse(read_bytes(fs::path(LUCENT_SOURCE_DIR) / "materials/library/marble.json"));
-  for (const std::string name : {std::string("a--b-"), std::string("end\\"), std::string("x\x1b[31m\ny"),
-                                 std::string("q\"uote<&>'")}) {
-    m["name"] = name;
-    write_file(dir / "m.json", m.dump());
-    for (const char* target : {"mitsuba", "materialx", "openpbr", "pbrt"}) {
-      const std::string ext = std::string(target) == "pbrt" ? ".pbrt" : std::string(target) == "mitsuba" ? ".xml" : ".mtlx";
-      const fs::path out = dir / (std::string("out") + ext);
-      const CommandResult r = run_lucent("export --material \"" + (dir / "m.json").string() +
-                                         "\" --to " + target + " -o \"" + out.string() + "\"");
-      ASSERT_EQ(r.exit_code, 0) << target << ": " << r.err;
-      for (const char ch : r.out + r.err)
-        EXPECT_FALSE(static_cast<unsigned char>(ch) < 0x20 && ch != '\n') << target << ": raw control character";
-      const std::string text = read_bytes(out);
-      if (ext != ".pbrt") {
-        // Inside every comment no "--", and no comment ends in "-".
-        for (std::size_t at = text.find("<!--"); at != std::string::npos; at = text.find("<!--", at + 4)) {
-          const std::size_t end = text.find("-->", at + 4);
-          ASSERT_NE(end, std::string::npos) << target;
-          const std::string body = text.substr(at + 4, end - at - 4);
-          EXPECT_EQ(body.find("--"), std::string::npos) << target << ": " << body;
-          EXPECT_NE(body.back(), '-') << target << ": " << body;
-        }
-        for (const char ch : text)
-          EXPECT_FALSE(static_cast<unsigned char>(ch) < 0x20 && ch != '\n' && ch != '\t' && ch != '\r') << target;
-      } else {
-        // Every line's quotes pair up, none escaped.
-        std::istringstream in(text);
-        for (std::string line; std::getline(in, line);) {
-          if (!line.empty() && line[0] == '#') continue;
-          EXPECT_EQ(std::count(line.begin(), line.end(), '"') % 2, 0) << line;
-          EXPECT_EQ(line.find('\\'), std::string::npos) << line;
-        }
-      }
-      fs::remove(out);
-    }
-  }
-  fs::remove_all(dir);
+// "--", a pbrt string's closing quote escaped by a trailing backslash, control characters, markup):
+// the file stays well formed (every XML comment without "--" or a trailing "-", no raw control
+// character; pbrt's quotes pair, none escaped), and what lucent prints has no raw control character.
+struct NamedExport {
+  std::string label, name, target;
+};
+void PrintTo(const NamedExport& c, std::ostream* os) { *os << c.label; }
+
+std::vector<NamedExport> named_exports() {
+  const std::vector<std::pair<std::string, std::string>> names = {
+      {"dashes", "a--b-"}, {"backslash", "end\\"}, {"escape_newline", "x\x1b[31m\ny"},
+      {"markup", "q\"uote<&>'"}};
+  std::vector<NamedExport> out;
+  for (const auto& [label, name] : names)
+    for (const char* target : {"mitsuba", "materialx", "openpbr", "pbrt", "gltf"})
+      out.push_back({label + "_" + target, name, target});
+  return out;
 }
 
+class Injection : public ::testing::TestWithParam<NamedExport> {};
+TEST_P(Injection, NamesAreDataInEveryExport) {
+  const NamedExport& c = GetParam();
+  const fs::path dir = scratch_dir("hostile-names-" + c.label);
+  nlohmann::json m = nlohmann::json::parse(
+      read_bytes(fs::path(LUCENT_SOURCE_DIR) / "materials/library/marble.json"));
+  m["name"] = c.name;
+  write_file(dir / "m.json", m.dump());
+  const std::string ext = c.target == "pbrt"      ? ".pbrt"
+                          : c.target == "mitsuba" ? ".xml"
+                          : c.target == "gltf"    ? ".gltf"
+                                                  : ".mtlx";
+  const fs::path out = dir / ("out" + ext);
+  const CommandResult r = run_lucent("export --material \"" + (dir / "m.json").string() + "\" --to " +
+                                     c.target + " -o \"" + out.string() + "\"");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char ch : r.out + r.err)
+    EXPECT_FALSE(static_cast<unsigned char>(ch) < 0x20 && ch != '\n') << "raw control character";
+  const std::string text = read_bytes(out);
+  if (ext == ".pbrt") {
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) {
+      if (!line.empty() && line[0] == '#') continue;
+      EXPECT_EQ(std::count(line.begin(), line.end(), '"') % 2, 0) << line;
+      EXPECT_EQ(line.find('\\'), std::string::npos) << line;
+    }
+  } else if (ext == ".gltf") {
+    EXPECT_NO_THROW((void)nlohmann::json::parse(text)) << text.substr(0, 300);
+  } else {
+    for (std::size_t at = text.find("<!--"); at != std::string::npos; at = text.find("<!--", at + 4)) {
+      const std::size_t end = text.find("-->", at + 4);
+      ASSERT_NE(end, std::string::npos);
+      const std::string body = text.substr(at + 4, end - at - 4);
+      EXPECT_EQ(body.find("--"), std::string::npos) << body;
+      EXPECT_NE(body.back(), '-') << body;
+    }
+  }
+  for (const char ch : text)
+    EXPECT_FALSE(static_cast<unsigned char>(ch) < 0x20 && ch != '\n' && ch != '\t' && ch != '\r');
+  fs::remove_all(dir);
+}
+INSTANTIATE_TEST_SUITE_P(Table, Injection, ::testing::ValuesIn(named_exports()),
+                         [](const auto& info) { return info.param.label; });
+
 // An error naming a file whose name holds a newline and an escape stays one line, escapes shown.
-TEST(Injection, AnErrorNamingAHostileFileNameIsOneLine) {
+TEST(InjectionErrors, AnErrorNamingAHostileFileNameIsOneLine) {
   const fs::path dir = scratch_dir("hostile-error-name");
   const std::string name = (dir / "bad\nname\x1b[2J.json").string();
   const CommandResult r = run_lucent("fit \"" + name + "\" --ior 1.3 -o \"" + (dir / "m.json").string() + "\"");
@@ -437,7 +455,7 @@ TEST(Injection, AnErrorNamingAHostileFileNameIsOneLine) {
 
 // A name that is not UTF-8 (nlohmann refuses to write it into JSON) is one clean error, not an
 // internal one, and nothing is written.
-TEST(Injection, ANameThatIsNotUtf8IsOneCleanError) {
+TEST(InjectionErrors, ANameThatIsNotUtf8IsOneCleanError) {
   const fs::path dir = scratch_dir("hostile-utf8");
   const CommandResult r = run_lucent("fit \"" + (world() / "acq/profile.json").string() +
                                      "\" --quality fast -q --name \"$(printf 'bad\\377\\376name')\" -o \"" +
