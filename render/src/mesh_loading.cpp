@@ -392,8 +392,13 @@ Mesh finish_mesh(Mesh mesh, const std::string& name_or_path, double object_size_
 
   drop_degenerate_triangles(mesh);
   if (mesh.triangles.empty()) throw Error("mesh '" + name_or_path + "': it has no triangles");
-  // Triangles of zero area (three corners on a line, or at one point) have no surface to light: a
-  // mesh of nothing else rendered black with exit 0.
+  if (const std::size_t twins = drop_duplicate_triangles(mesh); twins > 0) {
+    warn("warning: " + name_or_path + ": dropped " + std::to_string(twins) +
+         " triangles given twice (the same three corners)");
+  }
+  centre_and_scale(mesh, object_size_mm);  // refuses vertices that all coincide, by name
+  // Then triangles of zero area (three corners on a line) have no surface to light: a mesh of
+  // nothing else rendered black with exit 0.
   double area = 0;
   for (const auto& t : mesh.triangles)
     area += double((mesh.positions[t[1]] - mesh.positions[t[0]])
@@ -401,11 +406,6 @@ Mesh finish_mesh(Mesh mesh, const std::string& name_or_path, double object_size_
                        .norm());
   if (!(area > 0))
     throw Error("mesh '" + name_or_path + "': every triangle has zero area (no surface to render)");
-  if (const std::size_t twins = drop_duplicate_triangles(mesh); twins > 0) {
-    warn("warning: " + name_or_path + ": dropped " + std::to_string(twins) +
-         " triangles given twice (the same three corners)");
-  }
-  centre_and_scale(mesh, object_size_mm);
 
   orient_outward(mesh);
   if (!exact_normals) {
