@@ -564,7 +564,7 @@ FitResult fit_profiles(const std::vector<ProfileData>& input, const FitOptions& 
       // A table without that g: nothing to say.
     }
   }
-  // What each input's system response did (convolved, or its 2D near field left out).
+  // What each input's system response did (convolved with what, or a pencil beam assumed).
   for (const ProfileData& d : data)
     result.notes.push_back(detail::describe_system_response(d, options.beam_sigma_mm));
   // A semi-infinite answer holds for samples thick enough: the thinnest slab whose profile stays
