@@ -69,6 +69,12 @@ inline std::string first_line_or_all(const std::string& s) {
   return s.size() > 600 ? s.substr(0, 600) + "..." : s;
 }
 
+/// Every refusal runs bounded: 1 GiB of address space (lucent itself starts in about 300 MiB; the
+/// audit's memory blow-ups reached 1.6-3.2 GB from inputs of a few KB, so a reader that sizes an
+/// allocation from a header it has not checked fails here with bad_alloc and no named field) and 120 s
+/// (every refusal takes well under 10 s on 2 cores, ASan included; the audit's hangs never ended).
+inline constexpr RunLimits kRefusalLimits{1L << 20, 120};
+
 /// The shared, valid inputs every table mutates: made once per test binary.
 const fs::path& world();
 
@@ -79,7 +85,7 @@ inline void expect_clean_refusal(const BadCase& c) {
   const auto world_before = snapshot(world());
   const std::string args =
       replace_all(replace_all(c.args, "{dir}", dir.string()), "{world}", world().string());
-  const CommandResult r = run_lucent(args, "bad-" + c.name);
+  const CommandResult r = run_lucent(args, "bad-" + c.name, kRefusalLimits);
   EXPECT_TRUE(r.exit_code == 1 || r.exit_code == 2)
       << c.name << ": exit " << r.exit_code << "\nargs: " << args << "\nstderr: " << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1)

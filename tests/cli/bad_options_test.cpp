@@ -232,25 +232,6 @@ TEST(Outputs, EverySubcommandAnswersVersion) {
   }
 }
 
-// Starts lucent in the background; returns its pid.
-pid_t spawn_lucent(const std::string& args, const fs::path& log) {
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    const std::string command = std::string("exec \"") + LUCENT_BINARY + "\" " + args + " >" +
-                                quoted(log) + " 2>&1 </dev/null";
-    ::execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
-  return pid;
-}
-
-bool has_temporary(const fs::path& dir) {
-  for (const auto& e : fs::directory_iterator(dir)) {
-    if (e.path().filename().string().find(".tmp-") != std::string::npos) return true;
-  }
-  return false;
-}
-
 // Waits (up to 60 s) until lucent has a temporary in `dir`, i.e. is in the middle of its work.
 bool wait_for_temporary(const fs::path& dir) {
   for (int i = 0; i < 600; ++i) {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -33,11 +34,37 @@ inline std::filesystem::path scratch_dir(const std::string& name) {
   return dir;
 }
 
+/// Bounds on a run: its address space (`ulimit -v`, KiB; 0 = none) and its wall time (seconds; the
+/// run is killed past it and reports exit 137 or 124).
+struct RunLimits {
+  long memory_kib = 0;
+  int seconds = 0;
+};
+
+/// Whether this build runs under AddressSanitizer, which reserves terabytes of address space up
+/// front: `ulimit -v` cannot bound such a process, so memory bounds are skipped there.
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr bool kAddressSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+inline constexpr bool kAddressSanitizer = true;
+#else
+inline constexpr bool kAddressSanitizer = false;
+#endif
+#else
+inline constexpr bool kAddressSanitizer = false;
+#endif
+
 /// `args` is appended to the binary's path verbatim (quote what needs quoting).
-inline CommandResult run_lucent(const std::string& args, const std::string& name = "cmd") {
+inline CommandResult run_lucent(const std::string& args, const std::string& name = "cmd",
+                                RunLimits limits = {}) {
   const auto dir = scratch_dir("run-" + name);
   const auto out = dir / "stdout", err = dir / "stderr";
-  const std::string command = std::string("\"") + LUCENT_BINARY + "\" " + args + " >\"" +
+  std::string prefix;
+  if (limits.memory_kib > 0 && !kAddressSanitizer)
+    prefix += "ulimit -v " + std::to_string(limits.memory_kib) + " && exec ";
+  if (limits.seconds > 0) prefix += "timeout -s KILL " + std::to_string(limits.seconds) + " ";
+  const std::string command = prefix + "\"" + LUCENT_BINARY + "\" " + args + " >\"" +
                               out.string() + "\" 2>\"" + err.string() + "\" </dev/null";
   const int status = std::system(command.c_str());
   CommandResult result;
@@ -46,6 +73,26 @@ inline CommandResult run_lucent(const std::string& args, const std::string& name
   result.err = read_text(err);
   std::filesystem::remove_all(dir);
   return result;
+}
+
+/// Starts lucent in the background (stdout and stderr to `log`); returns its pid for kill/waitpid.
+inline pid_t spawn_lucent(const std::string& args, const std::filesystem::path& log) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const std::string command = std::string("exec \"") + LUCENT_BINARY + "\" " + args + " >\"" +
+                                log.string() + "\" 2>&1 </dev/null";
+    ::execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  return pid;
+}
+
+/// Whether `dir` holds one of lucent's temporaries (".tmp-" in the name).
+inline bool has_temporary(const std::filesystem::path& dir) {
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec))
+    if (e.path().filename().string().find(".tmp-") != std::string::npos) return true;
+  return false;
 }
 
 }  // namespace lucent::testing
