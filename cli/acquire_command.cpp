@@ -4,8 +4,8 @@
 
 #include "commands.h"
 #include "lucent/acquire/acquire.h"
-#include "lucent/materials/atomic_file.h"
-#include "lucent/materials/error.h"
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
 #include "progress.h"
 #include "validators.h"
 

@@ -9,8 +9,8 @@
 #include <filesystem>
 #include <sstream>
 
-#include "lucent/materials/error.h"
-#include "lucent/materials/json_file.h"
+#include "lucent/core/error.h"
+#include "lucent/core/json_file.h"
 
 namespace lucent::cli {
 namespace {

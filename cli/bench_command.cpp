@@ -1,11 +1,11 @@
-// `lucent bench`: the speed/accuracy sweeps (DESIGN §8), written to notebooks_data/bench/.
+// `lucent bench`: the speed/accuracy sweeps (docs/DESIGN.md §8), written to notebooks_data/bench/.
 #include <cstdio>
 #include <iostream>
 #include <memory>
 
 #include "commands.h"
-#include "lucent/materials/atomic_file.h"
-#include "lucent/materials/error.h"
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
 #include "lucent/fit/fit_bench.h"
 #include "lucent/render/render_bench.h"
 #include "lucent/render/tradeoff_bench.h"
@@ -72,7 +72,7 @@ void register_bench_command(CLI::App& app) {
   auto fur_size = std::make_shared<std::string>("1280x1024");
   CLI::App* fur_cmd = bench->add_subcommand(
       "fur",
-      "Time the fur tile (seed 001) at the seed's 1280 x 1024 for each shell count: the CPU "
+      "Time the fur tile (Klotzli & Olano) at the seed's 1280 x 1024 for each shell count: the CPU "
       "precompute and the median draw per frame -> fur.csv");
   fur_cmd->add_option("--out", fur_options->out_csv, "CSV to write")->capture_default_str();
   fur_cmd->add_option("--shells", fur_options->shells, "shell counts to time (a row each)")

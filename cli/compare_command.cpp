@@ -10,13 +10,13 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
-#include "validators.h"
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
+#include "lucent/core/json_file.h"
 #include "lucent/imaging/image_io.h"
-#include "lucent/materials/atomic_file.h"
-#include "lucent/materials/error.h"
-#include "lucent/materials/json_file.h"
 #include "lucent/render/image_compare.h"
 #include "lucent/render/tone_map.h"
+#include "validators.h"
 
 namespace lucent::cli {
 namespace {

@@ -5,8 +5,8 @@
 #include <sstream>
 
 #include "lucent/acquire/beam.h"
+#include "lucent/core/error.h"
 #include "lucent/imaging/image_io.h"
-#include "lucent/materials/error.h"
 
 namespace lucent::cli {
 

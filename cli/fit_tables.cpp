@@ -10,8 +10,8 @@
 #include <sstream>
 
 #include "lucent/acquire/tabulate.h"
-#include "lucent/materials/atomic_file.h"
-#include "lucent/materials/error.h"
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
 #include "lucent/materials/oblique.h"
 #include "lucent/materials/radial_slices.h"
 #include "progress.h"

@@ -1,12 +1,13 @@
 #include <exception>
+#include <filesystem>
 #include <iostream>
 #include <new>
 
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
-#include "lucent/materials/atomic_file.h"
-#include "lucent/materials/error.h"
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
 #include "lucent/version.h"
 
 int main(int argc, char** argv) {
@@ -62,6 +63,13 @@ int main(int argc, char** argv) {
     }
     std::cerr << "lucent: internal error: " << lucent::printable(e.what()) << '\n';
     return 3;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // The file system refusing a path (a name longer than the file system allows, a folder that
+    // is a file, no permission, a full disk): the user's path or machine to fix, not lucent's bug.
+    std::cerr << "lucent: error: "
+              << lucent::printable(e.path1().empty() ? std::string("a file") : e.path1().string())
+              << ": " << lucent::printable(e.code().message()) << "; nothing written\n";
+    return 1;
   } catch (const std::bad_alloc&) {
     std::cerr << "lucent: error: out of memory (an input or a setting asks for more memory than "
                  "this machine has)\n";

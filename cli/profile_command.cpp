@@ -5,9 +5,9 @@
 #include <memory>
 
 #include "commands.h"
-#include "lucent/materials/json_file.h"
-#include "lucent/materials/atomic_file.h"
-#include "lucent/materials/error.h"
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
+#include "lucent/core/json_file.h"
 #include "lucent/materials/profile_table.h"
 
 namespace lucent::cli {

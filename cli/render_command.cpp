@@ -1,7 +1,7 @@
-// `lucent render`: a material on a mesh under lights or an environment map, rendered headless with
-// the real-time radiance-map technique or the CPU reference, written as PNG (tone-mapped) or EXR
-// (linear). Fills lucent::render's Scene, RenderSettings and ReferenceOptions; validates everything
-// before rendering so that bad input fails fast and leaves no output file.
+// `lucent render`: a material on a mesh under lights or an environment map, rendered headless by
+// any technique of the registry (technique.h), written as PNG (tone-mapped) or EXR (linear). Fills
+// lucent::render's Scene and TechniqueOptions; validates everything before rendering so that bad
+// input fails fast and leaves no output file.
 #include <unistd.h>
 
 #include <chrono>
@@ -14,16 +14,12 @@
 #include <vector>
 
 #include "commands.h"
-#include "lucent/materials/json_file.h"
-#include "lucent/materials/atomic_file.h"
-#include "lucent/materials/error.h"
-#include "lucent/render/fur_renderer.h"
-#include "lucent/render/hierarchical_renderer.h"
-#include "lucent/render/radiance_maps.h"
-#include "lucent/render/reference_renderer.h"
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
+#include "lucent/core/json_file.h"
 #include "lucent/render/render_settings.h"
 #include "lucent/render/scene.h"
-#include "lucent/render/sh_renderer.h"
+#include "lucent/render/technique.h"
 #include "lucent/render/tone_map.h"
 #include "scene_options.h"
 
@@ -64,38 +60,32 @@ void run_render(RenderArguments& render_args) {
   const auto start = std::chrono::steady_clock::now();
 
   const bool show_progress = ::isatty(STDERR_FILENO) != 0;
-  ImageRgb image;
-  RenderStats stats;
-  if (args.technique != "maps" && !render_args.snapshots.empty()) {
+  const TechniqueInfo& technique = technique_info(args.technique_id);
+  if (!technique.frame_snapshots && !render_args.snapshots.empty()) {
     throw Error("--snapshots: frame snapshots are of the radiance maps (--technique maps)");
   }
-  if (args.technique == "reference") {
-    if (show_progress) args.reference.progress = print_progress;
-    ReferenceImage result = render_reference(scene, args.settings.model, args.reference);
-    if (show_progress) std::fprintf(stderr, "\n");
-    image = std::move(result.image);
-    stats = std::move(result.stats);
-  } else if (args.technique == "sh") {
-    image = render_sh(scene, args.sh, &stats);
-  } else if (args.technique == "hierarchical") {
-    image = render_hierarchical(scene, args.hbe, &stats);
-  } else if (args.technique == "fur") {
-    image = render_fur(scene, args.fur, &stats, args.settings);
-  } else {
-    RadianceMapOptions options;
-    options.max_blur_level = args.max_blur;
-    for (int t : render_args.snapshots) {
-      if (t < 1 || t > args.settings.frames) {
-        throw Error("--snapshots: frames must be 1.." + std::to_string(args.settings.frames) +
-                    " (--frames), got " + std::to_string(t));
-      }
+  TechniqueOptions options{args.settings, {}, args.sh, args.hbe, args.fur, args.reference};
+  options.maps.max_blur_level = args.max_blur;
+  for (int t : render_args.snapshots) {
+    if (t < 1 || t > args.settings.frames) {
+      throw Error("--snapshots: frames must be 1.." + std::to_string(args.settings.frames) +
+                  " (--frames), got " + std::to_string(t));
     }
-    options.snapshot_frames = render_args.snapshots;
-    options.on_snapshot = [&](int t, const ImageRgb& snapshot) {
-      write_render_image(snapshot_path(render_args.output, t), snapshot, ToneMapOptions{});
-    };
-    image = render_radiance_maps(scene, args.settings, options, &stats, nullptr);
   }
+  options.maps.snapshot_frames = render_args.snapshots;
+  options.maps.on_snapshot = [&](int t, const ImageRgb& snapshot) {
+    write_render_image(snapshot_path(render_args.output, t), snapshot, ToneMapOptions{});
+  };
+  bool progress_shown = false;  // the techniques that report progress end their line here
+  if (show_progress) {
+    options.reference.progress = [&progress_shown](double fraction) {
+      progress_shown = true;
+      print_progress(fraction);
+    };
+  }
+  RenderStats stats;
+  const ImageRgb image = render_still(args.technique_id, scene, options, &stats);
+  if (progress_shown) std::fprintf(stderr, "\n");
 
   ToneMapOptions tone;
   tone.exposure = args.auto_exposure ? auto_exposure(image) : args.settings.exposure;
@@ -103,7 +93,7 @@ void run_render(RenderArguments& render_args) {
                      {{"lucent:units", "radiance, W mm^-2 sr^-1 per unit light"},
                       {"lucent:material", scene.material.name},
                       {"lucent:mesh", scene.mesh.name},
-                      {"lucent:technique", args.technique}});
+                      {"lucent:technique", technique.name}});
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::string extension = std::filesystem::path(render_args.output).extension().string();
@@ -118,9 +108,8 @@ void run_render(RenderArguments& render_args) {
                   {"lights", scene.lights.size()},
                   {"environment", args.env},
                   {"view", args.view}};
-  if (args.technique == "maps") doc["settings"] = args.settings.to_string();
-  if (args.technique == "sh") doc["settings"] = args.sh.to_string();
-  if (args.technique == "hierarchical") doc["settings"] = args.hbe.to_string();
+  if (const std::string settings = settings_text(args.technique_id, options); !settings.empty())
+    doc["settings"] = settings;
   if (!render_args.stats.empty()) {
     check_finite_json(doc, render_args.stats);
     write_file_atomically(render_args.stats, doc.dump(2) + "\n");
@@ -135,18 +124,13 @@ void run_render(RenderArguments& render_args) {
     check_finite_json(doc, "render --json");
     std::printf("%s\n", doc.dump(2).c_str());
   } else {
-    std::printf("render: wrote %s (%dx%d, %s, %s on %s, %s%s) in %.1f s\n", render_args.output.c_str(),
-              scene.camera.width, scene.camera.height,
-              args.technique == "maps" ? "radiance maps"
-              : args.technique == "sh"           ? "SH fast translucency"
-              : args.technique == "hierarchical" ? "hierarchical boundary elements"
-              : args.technique == "fur"          ? "fur shells with SH transfer"
-                                                 : "CPU reference",
-              materials::to_string(args.settings.model).c_str(), scene.mesh.name.c_str(),
-              png ? "exposure " : "linear",
-              png ? (std::to_string(tone.exposure) + (args.auto_exposure ? " (auto)" : "")).c_str()
-                  : "",
-              seconds);
+    std::printf(
+        "render: wrote %s (%dx%d, %s, %s on %s, %s%s) in %.1f s\n", render_args.output.c_str(),
+        scene.camera.width, scene.camera.height, technique.label.c_str(),
+        materials::to_string(args.settings.model).c_str(), scene.mesh.name.c_str(),
+        png ? "exposure " : "linear",
+        png ? (std::to_string(tone.exposure) + (args.auto_exposure ? " (auto)" : "")).c_str() : "",
+        seconds);
   }
   if (!args.default_rig.empty()) {
     std::string rig;

@@ -13,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 #include "lucent/materials/material.h"
 #include "lucent/materials/profile_table.h"
 #include "lucent/render/environment.h"
@@ -85,14 +85,11 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
   cmd->add_option("--env", args->env,
                   "FILE[:L]: lat-long environment map (.exr or .hdr), shown as background and lit "
                   "by L importance-sampled directional lights (default L = 16)");
-  cmd->add_option("--technique", args->technique,
-                  "maps (real-time radiance maps, OpenGL), sh (spherical-harmonics fast "
-                  "translucency, OpenGL, seed 000: not physically based), hierarchical "
-                  "(boundary elements on a face-cluster hierarchy, seed 004: the standard dipole, "
-                  "solved on the CPU, shaded per vertex on the GPU), fur (seed 001: shells with SH "
-                  "transfer; --mesh tile is the seed's tile, other meshes get a coat of shells "
-                  "over the maps' skin: an extension) or reference (CPU, slow, exact up to sampling noise)")
-      ->capture_default_str();
+  std::string technique_help;
+  const auto& all = render::techniques();
+  for (std::size_t i = 0; i < all.size(); ++i)
+    technique_help += (i == 0 ? "" : i + 1 == all.size() ? " or " : ", ") + all[i].help;
+  cmd->add_option("--technique", args->technique, technique_help)->capture_default_str();
   cmd->add_option("--model", args->model,
                   "tabulated (exact to Monte Carlo transport), ddipole (directional dipole) or "
                   "dipole (standard dipole); default: the material's fitted model, else tabulated "
@@ -142,7 +139,7 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
       ->capture_default_str();
   cmd->add_option("--irradiance-cache", args->irradiance_cache,
                   "reference (probes): on: area lights' irradiance from per-cluster projection "
-                  "maps (seed 002; bilinear between grid vertices evaluated once) instead of "
+                  "maps (Jacob 1993; bilinear between grid vertices evaluated once) instead of "
                   "shadow rays at every hit")
       ->capture_default_str();
   cmd->add_option("--passes", args->reference.passes,
@@ -169,7 +166,7 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
       ->capture_default_str();
   cmd->add_option("--disc-distribution", args->disc_distribution,
                   "maps: profile (radii importance-sampled from the material's own profile, "
-                  "weights exact at any texel size) or exponential (seed 003: e^(-sigma* r), "
+                  "weights exact at any texel size) or exponential (Dal Corso 2014: e^(-sigma* r), "
                   "sigma* = min sigma_tr / q)")
       ->capture_default_str();
   cmd->add_option("--q", args->settings.q,
@@ -178,7 +175,7 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
   cmd->add_option("--disc-selection", args->disc_selection,
                   "maps: which N of the M points a frame gathers: strata (one of each of N radius "
                   "strata, a new one every frame: converges to all M after M/N frames) or nearest "
-                  "(seed 003: the N nearest, every frame; misses the far profile)")
+                  "(Dal Corso 2014: the N nearest, every frame; misses the far profile)")
       ->capture_default_str();
   cmd->add_option("--shadow-map", args->sh.shadow_map_size,
                   "sh: the primary light's shadow map (and depth peel), texels per side")
@@ -211,10 +208,11 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
                   "each texel) or seed (its chord and wedge approximations, eqs. 1-2: the wedge "
                   "is 13-32% off once a disc leaves the texel corner)")
       ->capture_default_str();
-  cmd->add_option("--fur-coat", args->fur_coat,
-                  "on: a fur coat over the skin (an extension of seed 001): its transmittance "
-                  "T(cos theta), from the --fur-* hairs, attenuates the light entering the skin "
-                  "(maps, hierarchical, reference)")
+  cmd->add_option(
+         "--fur-coat", args->fur_coat,
+         "on: a fur coat over the skin (an extension of Klotzli & Olano): its transmittance "
+         "T(cos theta), from the --fur-* hairs, attenuates the light entering the skin "
+         "(maps, hierarchical, reference)")
       ->capture_default_str();
   cmd->add_option("--fur-tile-mm", args->fur.tile_mm,
                   "fur over a mesh: the tile's width, mm (its texels set the hair scale)")
@@ -223,7 +221,7 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
       ->capture_default_str();
   cmd->add_option("--hbe-irradiance-cache", args->hbe_irradiance_cache,
                   "hierarchical: on: area lights' leaf irradiance from per-cluster projection maps "
-                  "(seed 002) built once; off: 16 shadow rays per leaf every frame")
+                  "(Jacob 1993) built once; off: 16 shadow rays per leaf every frame")
       ->capture_default_str();
   cmd->add_option("--hbe-mode", args->hbe_mode,
                   "hierarchical: render (links kept), incremental (links repaired within "
@@ -284,18 +282,17 @@ SceneSetup build_scene(SceneArguments& args) {
     throw Error("--view: expected AZ in [-3600, 3600] degrees, EL in [-90, 90] degrees and DIST "
                 "in (0, 1e4] bounding radii, got '" + args.view + "'");
   }
-  if (args.technique != "maps" && args.technique != "sh" && args.technique != "hierarchical" &&
-      args.technique != "fur" && args.technique != "reference") {
-    throw Error("--technique: expected maps, sh, hierarchical, fur or reference, got '" +
-                args.technique + "'");
-  }
+  args.technique_id = render::parse_technique(args.technique);
+  const render::TechniqueInfo& technique = render::technique_info(args.technique_id);
   args.hbe.mode = render::hbe::parse_mode(args.hbe_mode);
   args.hbe.form_factor.rule = render::hbe::parse_segment_rule(args.hbe_rule);
   args.hbe.form_factor.placement = render::hbe::parse_dipole_placement(args.hbe_dipole);
   args.hbe.validate();
-  if (args.technique == "hierarchical" && !args.model.empty() && args.model != "dipole") {
-    throw Error("--model: the hierarchical technique integrates the standard dipole (seed 004), "
-                "got '" + args.model + "'; use --model dipole or leave it out");
+  if (technique.models.size() == 1 && !args.model.empty() &&
+      args.model != materials::to_string(technique.models.front())) {
+    throw Error("--model: the " + technique.name + " technique " + technique.model_note +
+                ", got '" + args.model + "'; use --model " +
+                materials::to_string(technique.models.front()) + " or leave it out");
   }
   if (args.sh_fresnel != "exact" && args.sh_fresnel != "schlick") {
     throw Error("--sh-fresnel: expected exact or schlick, got '" + args.sh_fresnel + "'");
@@ -344,16 +341,21 @@ SceneSetup build_scene(SceneArguments& args) {
   if (args.fur_coat != "on" && args.fur_coat != "off") {
     throw Error("--fur-coat: expected on or off, got '" + args.fur_coat + "'");
   }
-  if (args.fur_coat == "on" && args.technique == "sh") {
-    throw Error("--fur-coat: the sh technique's precomputed transfer has no fur coat; use maps, "
-                "hierarchical or reference");
+  if (args.fur_coat == "on" && !technique.fur_coat) {
+    // The fur technique is its own coat; the others take one over their skin.
+    throw Error("--fur-coat: the " + technique.name +
+                " technique's precomputed transfer has no fur "
+                "coat; use " +
+                render::technique_names([](const render::TechniqueInfo& t) {
+                  return t.fur_coat && t.id != render::TechniqueId::kFur;
+                }));
   }
   if (args.fur_coverage != "exact" && args.fur_coverage != "seed") {
     throw Error("--fur-coverage: expected exact or seed, got '" + args.fur_coverage + "'");
   }
   args.fur.coverage = args.fur_coverage == "seed" ? render::fur::CoverageRule::kSeed
                                                   : render::fur::CoverageRule::kExact;
-  if (args.technique == "fur" || args.fur_coat == "on") {
+  if (args.technique_id == render::TechniqueId::kFur || args.fur_coat == "on") {
     // Hair counts follow the tile's area (the seed's density at 64 x 64 texels).
     const double scale = double(args.fur.texels) * args.fur.texels / (64.0 * 64.0);
     args.fur.overcoat.hairs = int(std::lround(600 * scale));
@@ -399,7 +401,7 @@ SceneSetup build_scene(SceneArguments& args) {
   args.settings.model = !args.model.empty()
                             ? materials::parse_diffusion_model(args.model, "--model", true)
                             : materials::preferred_model(scene.material);
-  if (args.technique == "hierarchical") args.settings.model = DiffusionModel::kDipole;
+  if (technique.models.size() == 1) args.settings.model = technique.models.front();
   scene.mesh = load_mesh(args.mesh, args.object_size_mm);
   scene.lights = lights;
   if (env) {

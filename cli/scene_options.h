@@ -8,12 +8,13 @@
 
 #include <CLI/CLI.hpp>
 
-#include "lucent/render/reference_renderer.h"
 #include "lucent/render/fur.h"
 #include "lucent/render/hierarchical.h"
+#include "lucent/render/reference_renderer.h"
 #include "lucent/render/render_settings.h"
 #include "lucent/render/scene.h"
 #include "lucent/render/sh_renderer.h"
+#include "lucent/render/technique.h"
 
 namespace lucent::cli {
 
@@ -22,7 +23,8 @@ struct SceneArguments {
   std::string mesh = "sphere";
   std::vector<std::string> lights;
   std::string env;
-  std::string technique = "maps";
+  std::string technique = "maps";                                 ///< --technique as typed
+  render::TechniqueId technique_id = render::TechniqueId::kMaps;  ///< set by build_scene
   std::string model;
   std::string view = "30,20,3.4";  // 3.4 radii: the bounding sphere fits the 35-degree view
   std::string size;

@@ -10,8 +10,8 @@
 
 #include "commands.h"
 #include "lucent/acquire/simulate.h"
-#include "lucent/materials/atomic_file.h"
-#include "lucent/materials/error.h"
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
 #include "progress.h"
 #include "validators.h"
 

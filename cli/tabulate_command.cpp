@@ -9,13 +9,13 @@
 
 #include "batch.h"
 #include "commands.h"
+#include "lucent/acquire/tabulate.h"
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
+#include "lucent/core/json_file.h"
+#include "lucent/materials/profile_table.h"
 #include "progress.h"
 #include "validators.h"
-#include "lucent/materials/atomic_file.h"
-#include "lucent/acquire/tabulate.h"
-#include "lucent/materials/error.h"
-#include "lucent/materials/json_file.h"
-#include "lucent/materials/profile_table.h"
 
 namespace lucent::cli {
 namespace {

@@ -8,8 +8,8 @@
 #include <string>
 
 #include "commands.h"
-#include "lucent/materials/atomic_file.h"
-#include "lucent/materials/error.h"
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
 #include "progress.h"
 #include "scene_options.h"
 #if LUCENT_HAS_VIEWER
@@ -46,7 +46,7 @@ void run_view(ViewArguments& args) {
   options.reference = args.scene.reference;
   options.view = {setup.azimuth_deg, setup.elevation_deg, setup.distance_radii};
   options.object_size_mm = args.scene.object_size_mm;
-  options.technique = args.scene.technique;
+  options.technique = args.scene.technique_id;
   options.sh = args.scene.sh;
   options.hbe = args.scene.hbe;
   options.fur = args.scene.fur;

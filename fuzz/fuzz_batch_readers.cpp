@@ -9,8 +9,8 @@
 #include <string>
 
 #include "batch.h"
-#include "lucent/materials/error.h"
-#include "lucent/materials/json_file.h"
+#include "lucent/core/error.h"
+#include "lucent/core/json_file.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string bytes(reinterpret_cast<const char*>(data), size);

@@ -9,8 +9,8 @@
 #include <cstdint>
 #include <string_view>
 
+#include "lucent/core/error.h"
 #include "lucent/imaging/camera_raw.h"
-#include "lucent/materials/error.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view bytes(reinterpret_cast<const char*>(data), size);

@@ -6,8 +6,8 @@
 #include <string>
 #include <string_view>
 
+#include "lucent/core/error.h"
 #include "lucent/fit/fit_data.h"
-#include "lucent/materials/error.h"
 #include "lucent/materials/profile_table.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -9,8 +9,8 @@
 #include <fstream>
 #include <string>
 
+#include "lucent/core/error.h"
 #include "lucent/imaging/image_io.h"
-#include "lucent/materials/error.h"
 
 namespace {
 

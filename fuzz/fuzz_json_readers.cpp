@@ -7,9 +7,9 @@
 
 #include "lucent/acquire/capture.h"
 #include "lucent/acquire/profile.h"
+#include "lucent/core/error.h"
+#include "lucent/core/json_file.h"
 #include "lucent/fit/fit_data.h"
-#include "lucent/materials/error.h"
-#include "lucent/materials/json_file.h"
 #include "lucent/materials/material.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 #include "lucent/render/mesh_io.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -13,7 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 #include "lucent/materials/transport_table.h"
 
 namespace {

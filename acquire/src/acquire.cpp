@@ -10,10 +10,10 @@
 #include "lucent/acquire/camera.h"
 #include "lucent/acquire/capture.h"
 #include "lucent/acquire/hdr_merge.h"
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
 #include "lucent/imaging/camera_raw.h"
 #include "lucent/imaging/image_io.h"
-#include "lucent/materials/atomic_file.h"
-#include "lucent/materials/error.h"
 #include "lucent/version.h"
 
 namespace lucent::acquire {
@@ -48,9 +48,10 @@ void validate(const AcquireOptions& o) {
 }
 
 // Beam power from a Lambertian reference of reflectance rho: its radiance integrated over the plane
-// is P rho / pi (DESIGN §5), so P = (pi / rho) sum (L - background) pixel_area. The background
-// (dark offsets left after subtraction, stray light) is the median of a ring of pixels along the
-// border, far from the spot; black-masked pixels count as 0, non-finite ones as background.
+// is P rho / pi (docs/DESIGN.md §5), so P = (pi / rho) sum (L - background) pixel_area. The
+// background (dark offsets left after subtraction, stray light) is the median of a ring of pixels
+// along the border, far from the spot; black-masked pixels count as 0, non-finite ones as
+// background.
 struct BeamPower {
   std::array<double, 3> power{};
   std::array<double, 3> standard_error{};

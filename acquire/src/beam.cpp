@@ -5,7 +5,7 @@
 #include <sstream>
 #include <vector>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 
 namespace lucent::acquire {
 namespace {

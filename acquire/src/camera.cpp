@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <random>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 
 namespace lucent::acquire {
 namespace {

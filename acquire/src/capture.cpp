@@ -5,11 +5,11 @@
 #include <set>
 #include <sstream>
 
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
+#include "lucent/core/json_file.h"
 #include "lucent/imaging/camera_raw.h"
-#include "lucent/materials/atomic_file.h"
-#include "lucent/materials/error.h"
 #include "slab_fields.h"
-#include "lucent/materials/json_file.h"
 
 namespace lucent::acquire {
 namespace {

@@ -8,8 +8,8 @@
 #include <opencv2/photo.hpp>
 
 #include "lucent/acquire/camera.h"
+#include "lucent/core/error.h"
 #include "lucent/imaging/image_io.h"
-#include "lucent/materials/error.h"
 
 namespace lucent::acquire {
 namespace {

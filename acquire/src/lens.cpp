@@ -7,7 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lucent/acquire/simulate.h"
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 
 namespace lucent::acquire {
 

@@ -22,7 +22,8 @@
 // * The free path left over when a packet meets a boundary is carried over after the reflection
 //   (as MCML does); by the memorylessness of the exponential this is the same as drawing anew.
 //   Free paths come from a ziggurat sampler (exact, no log in the common case).
-// * The camera image is a next-event estimate at every collision (DESIGN §5): the collision at y
+// * The camera image is a next-event estimate at every collision (docs/DESIGN.md §5): the collision
+// at y
 //   with packet weight w (before absorption) and direction of travel d sends
 //     L += w albedo p_HG(d . w_t) e^(-sigma_t s) T(cos_t) / (eta^2 cos_t A_pixel)
 //   to the pixel containing the exit point y + s w_t, where w_t is the direction inside that
@@ -51,7 +52,7 @@
 #include <sstream>
 #include <thread>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 #include "lucent/materials/fresnel.h"
 #include "monte_carlo_random.h"
 

@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <sstream>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 
 namespace lucent::acquire {
 namespace {

@@ -7,10 +7,10 @@
 #include <set>
 
 #include "lucent/acquire/hdr_merge.h"
-#include "lucent/materials/atomic_file.h"
-#include "lucent/materials/error.h"
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
+#include "lucent/core/json_file.h"
 #include "slab_fields.h"
-#include "lucent/materials/json_file.h"
 
 namespace lucent::acquire {
 namespace {

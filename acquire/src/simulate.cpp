@@ -1,15 +1,15 @@
 #include "lucent/acquire/simulate.h"
-#include "lucent/materials/json_file.h"
+#include "lucent/core/json_file.h"
 
 #include <cmath>
 #include <numbers>
 #include <sstream>
 
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
 #include "lucent/imaging/image_io.h"
-#include "lucent/materials/atomic_file.h"
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/directional_dipole.h"
-#include "lucent/materials/error.h"
 #include "lucent/materials/fresnel.h"
 #include "lucent/version.h"
 

@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 
 namespace lucent::acquire::detail {
 

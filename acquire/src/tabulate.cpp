@@ -42,7 +42,7 @@
 #include <string>
 #include <thread>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 #include "lucent/materials/fresnel.h"
 #include "lucent/version.h"
 #include "monte_carlo_random.h"

@@ -1,6 +1,6 @@
 #include "lucent/fit/fit_bench.h"
 
-#include "lucent/materials/json_file.h"
+#include "lucent/core/json_file.h"
 
 #include <unistd.h>
 #include <algorithm>
@@ -13,10 +13,10 @@
 
 #include "lucent/acquire/acquire.h"
 #include "lucent/acquire/simulate.h"
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
 #include "lucent/fit/fit.h"
 #include "lucent/imaging/plot.h"
-#include "lucent/materials/atomic_file.h"
-#include "lucent/materials/error.h"
 
 namespace lucent::fit {
 namespace {

@@ -9,8 +9,8 @@
 #include <sstream>
 
 #include "lucent/acquire/profile.h"
-#include "lucent/materials/error.h"
-#include "lucent/materials/json_file.h"
+#include "lucent/core/error.h"
+#include "lucent/core/json_file.h"
 
 namespace lucent::fit {
 namespace {

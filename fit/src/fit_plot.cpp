@@ -8,8 +8,8 @@
 #include <numbers>
 
 #include "fit_residuals.h"
+#include "lucent/core/error.h"
 #include "lucent/imaging/plot.h"
-#include "lucent/materials/error.h"
 #include "model_prediction.h"
 
 namespace lucent::fit {

@@ -1,6 +1,6 @@
-// The residuals of a fit (DESIGN §6): what one residual block measures (a run of radial bins or
-// single pixels of one channel of one capture) and the Ceres cost functions over it, for every
-// model. Internal to lucent_fit (fit_solve.cpp builds the problem from these).
+// The residuals of a fit (docs/DESIGN.md §6): what one residual block measures (a run of radial
+// bins or single pixels of one channel of one capture) and the Ceres cost functions over it, for
+// every model. Internal to lucent_fit (fit_solve.cpp builds the problem from these).
 #pragma once
 
 #include <ceres/ceres.h>

@@ -1,5 +1,5 @@
-// The Ceres problem of a fit (DESIGN §6): residuals (log-ratio of model to data in units of the
-// relative standard error) for every model, the solve, the covariance from the Jacobian with
+// The Ceres problem of a fit (docs/DESIGN.md §6): residuals (log-ratio of model to data in units of
+// the relative standard error) for every model, the solve, the covariance from the Jacobian with
 // undetermined directions named, per-channel statistics. Internal to lucent_fit.
 #pragma once
 

@@ -15,7 +15,8 @@
 namespace lucent::fit::detail {
 namespace {
 
-// Far-field log-slope and total reflectance of one channel's radial bins: start values (DESIGN §6).
+// Far-field log-slope and total reflectance of one channel's radial bins: start values
+// (docs/DESIGN.md §6).
 double far_field_sigma_tr(const RadialBins& bins, int c) {
   std::vector<std::size_t> ok;
   for (std::size_t i = 0; i < bins.size(); ++i) {

@@ -1,6 +1,6 @@
-// Start values of a fit from the data alone (DESIGN §6): the far-field log-slope gives sigma_tr,
-// the total reflectance (closed-form dipole inversion) gives alpha'; a coarse grid search when
-// the profile has no exponential tail. Internal to lucent_fit.
+// Start values of a fit from the data alone (docs/DESIGN.md §6): the far-field log-slope gives
+// sigma_tr, the total reflectance (closed-form dipole inversion) gives alpha'; a coarse grid search
+// when the profile has no exponential tail. Internal to lucent_fit.
 #pragma once
 
 #include "lucent/fit/fit_data.h"

@@ -18,7 +18,7 @@
 #include <limits>
 #include <sstream>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 
 namespace lucent::fit::detail {
 namespace {

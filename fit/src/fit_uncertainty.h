@@ -1,5 +1,5 @@
 // After the solves: total uncertainty (statistical and the model's own systematic error), the
-// warnings a result needs, and which cheaper model reproduces the accurate one (DESIGN §6).
+// warnings a result needs, and which cheaper model reproduces the accurate one (docs/DESIGN.md §6).
 // Internal to lucent_fit.
 #pragma once
 

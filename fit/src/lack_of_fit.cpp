@@ -39,7 +39,6 @@ RadialStructure radial_structure(const std::vector<double>& r, const double* e, 
       a2 += 1 - m * m;
       model += m;  // the model's error, in units of the residuals (the table's SEs taken as they are)
     }
-    const double count = b - a;
     const double variance = data_scale2 * a2 + model * model;
     s.q += sum * sum / variance;
     s.mean.push_back(sum / std::sqrt(variance));

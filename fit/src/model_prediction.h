@@ -1,5 +1,5 @@
 // The predicted measurement pi L / P of a capture, per channel, for a bin or pixel footprint: the
-// BSSRDF with both Fresnel transmittances (DESIGN §6), averaged over the footprint by
+// BSSRDF with both Fresnel transmittances (docs/DESIGN.md §6), averaged over the footprint by
 // Gauss-Legendre quadrature. Templated for ceres::Jet.
 #pragma once
 
@@ -182,7 +182,7 @@ T tabulated_pixel(const materials::TabulatedModel<T>& m, materials::TableQuantit
 /// dipole): the ddipole's pi S_d for light from w_i over a pixel footprint, each point multiplied
 /// by the table's ratio to the ddipole at normal incidence at that radius, C(r) = table(r) /
 /// (pi S_d,normal(r)). The ddipole carries the asymmetry of the oblique source; the table corrects
-/// its level and radial shape, which are what it gets wrong (DESIGN §4.1).
+/// its level and radial shape, which are what it gets wrong (docs/DESIGN.md §4.1).
 template <typename T>
 T corrected_ddipole_pixel(const materials::TabulatedModel<T>& tab,
                           const materials::DirectionalDipole<T>& dd, materials::TableQuantity q,

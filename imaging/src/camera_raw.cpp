@@ -19,8 +19,8 @@
 #include <mutex>
 #include <set>
 
-#include "lucent/materials/error.h"
-#include "lucent/materials/json_file.h"
+#include "lucent/core/error.h"
+#include "lucent/core/json_file.h"
 
 namespace lucent::imaging {
 namespace {

@@ -5,9 +5,9 @@
 #include <memory>
 #include <string>
 
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
 #include "lucent/imaging/camera_raw.h"
-#include "lucent/materials/atomic_file.h"
-#include "lucent/materials/error.h"
 
 namespace lucent::imaging {
 namespace {

@@ -20,10 +20,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
+#include "lucent/core/json_file.h"
 #include "lucent/imaging/camera_raw.h"
-#include "lucent/materials/atomic_file.h"
-#include "lucent/materials/error.h"
-#include "lucent/materials/json_file.h"
 
 namespace lucent::imaging {
 

@@ -11,9 +11,9 @@
 #include <numbers>
 #include <sstream>
 
-#include "lucent/materials/atomic_file.h"
-#include "lucent/materials/error.h"
-#include "lucent/materials/xml_text.h"
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
+#include "lucent/core/xml_text.h"
 #include "plot_layout.h"
 
 namespace lucent::imaging {

@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <sstream>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 
 namespace lucent::imaging::plot_detail {
 

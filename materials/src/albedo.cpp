@@ -3,8 +3,8 @@
 #include <cmath>
 #include <string>
 
+#include "lucent/core/error.h"
 #include "lucent/materials/dipole.h"
-#include "lucent/materials/error.h"
 
 namespace lucent::materials {
 

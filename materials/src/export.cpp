@@ -7,10 +7,10 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "lucent/core/error.h"
+#include "lucent/core/xml_text.h"
 #include "lucent/materials/albedo.h"
 #include "lucent/materials/dipole.h"
-#include "lucent/materials/error.h"
-#include "lucent/materials/xml_text.h"
 
 namespace lucent::materials {
 namespace {

@@ -1,8 +1,8 @@
-// The material file ("format": "lucent-material", "version": 1; DESIGN §3) and the bundled library.
-// The reader accepts exactly the documented fields and rejects everything else with one line naming
-// the file, the field, what was expected and what was found (STYLE 4).
+// The material file ("format": "lucent-material", "version": 1; docs/DESIGN.md §3) and the bundled
+// library. The reader accepts exactly the documented fields and rejects everything else with one
+// line naming the file, the field, what was expected and what was found (STYLE 4).
 #include "lucent/materials/material.h"
-#include "lucent/materials/json_file.h"
+#include "lucent/core/json_file.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -17,10 +17,10 @@
 #include <string_view>
 #include <system_error>
 
-#include "lucent/materials/atomic_file.h"
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
 #include "lucent/materials/albedo.h"
 #include "lucent/materials/dipole.h"
-#include "lucent/materials/error.h"
 
 namespace lucent::materials {
 namespace {

@@ -6,8 +6,8 @@
 #include <numbers>
 #include <sstream>
 
+#include "lucent/core/error.h"
 #include "lucent/materials/dipole.h"
-#include "lucent/materials/error.h"
 #include "lucent/materials/quadrature.h"
 #include "lucent/materials/radial_slices.h"
 #include "lucent/materials/tabulated.h"

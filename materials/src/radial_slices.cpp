@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 #include "lucent/materials/oblique.h"
 
 namespace lucent::materials {

@@ -10,7 +10,7 @@
 #include <random>
 #include <sstream>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 #include "lucent/materials/oblique.h"
 
 namespace lucent::materials {

@@ -1,8 +1,8 @@
 // The transport table file and the finishing of Monte Carlo group tallies (transport_table.h).
 #include "lucent/materials/transport_table.h"
 
-#include "lucent/materials/atomic_file.h"
-#include "lucent/materials/json_file.h"
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/json_file.h"
 
 #include <zlib.h>
 
@@ -19,8 +19,8 @@
 #include <sstream>
 #include <tuple>
 
-#include "lucent/materials/atomic_file.h"
-#include "lucent/materials/error.h"
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
 
 #ifndef LUCENT_TABLE_DIR
 #define LUCENT_TABLE_DIR ""

@@ -22,9 +22,9 @@
 #include "lucent/acquire/capture.h"
 #include "lucent/acquire/hdr_merge.h"
 #include "lucent/acquire/profile.h"
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
 #include "lucent/imaging/image_io.h"
-#include "lucent/materials/atomic_file.h"
-#include "lucent/materials/error.h"
 #include "raw_exr.h"
 
 // One test file per executable includes this: plain (external) definitions are fine.

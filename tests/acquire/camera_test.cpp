@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 
 namespace lucent::acquire {
 namespace {

@@ -11,7 +11,7 @@
 
 #include "lucent/acquire/photon_transport.h"
 #include "lucent/acquire/tabulate.h"
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 #include "lucent/materials/oblique.h"
 #include "lucent/materials/tabulated.h"
 

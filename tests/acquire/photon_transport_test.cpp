@@ -13,8 +13,8 @@
 #include <utility>
 #include <vector>
 
+#include "lucent/core/error.h"
 #include "lucent/materials/dipole.h"
-#include "lucent/materials/error.h"
 #include "lucent/materials/fresnel.h"
 #include "lucent/materials/material.h"
 #include "lucent/materials/quadrature.h"

@@ -7,8 +7,8 @@
 #include <numbers>
 
 #include "lucent/acquire/capture.h"
+#include "lucent/core/error.h"
 #include "lucent/imaging/image_io.h"
-#include "lucent/materials/error.h"
 
 namespace lucent::acquire {
 namespace {

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "lucent/acquire/photon_transport.h"
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 #include "lucent/materials/tabulated.h"
 #include "lucent/materials/transport_table.h"
 

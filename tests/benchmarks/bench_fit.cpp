@@ -1,5 +1,5 @@
-// Speed of fitting (DESIGN §8): a 3-channel standard-dipole fit of a 150-bin radial profile,
-// covariance included, one core. Run: bench_fit --benchmark_repetitions=5
+// Speed of fitting (docs/DESIGN.md §8): a 3-channel standard-dipole fit of a 150-bin radial
+// profile, covariance included, one core. Run: bench_fit --benchmark_repetitions=5
 //   --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 

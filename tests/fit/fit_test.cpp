@@ -8,9 +8,9 @@
 #include <utility>
 #include <vector>
 
+#include "lucent/core/error.h"
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/directional_dipole.h"
-#include "lucent/materials/error.h"
 #include "lucent/materials/fresnel.h"
 #include "lucent/materials/profile_table.h"
 

@@ -7,9 +7,9 @@
 #include <fstream>
 #include <random>
 
+#include "lucent/core/error.h"
 #include "lucent/imaging/camera_raw.h"
 #include "lucent/imaging/image_io.h"
-#include "lucent/materials/error.h"
 
 namespace lucent::imaging {
 namespace {

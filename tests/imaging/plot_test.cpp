@@ -12,7 +12,7 @@
 #include <string>
 #include <thread>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 
 namespace lucent::imaging {
 namespace {

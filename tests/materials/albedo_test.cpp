@@ -2,8 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "lucent/core/error.h"
 #include "lucent/materials/dipole.h"
-#include "lucent/materials/error.h"
 
 namespace lucent::materials {
 namespace {

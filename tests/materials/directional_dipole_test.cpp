@@ -128,7 +128,7 @@ TEST(DirectionalDipole, ObliqueIncidenceShiftsLightForward) {
 }
 
 TEST(DirectionalDipole, TotalReflectanceExceedsTheDipoleByTheKnownMargin) {
-  // DESIGN §4.1: for albedo near 1 the reference formulation overestimates total diffuse
+  // docs/DESIGN.md §4.1: for albedo near 1 the reference formulation overestimates total diffuse
   // reflectance by 20-30% against Monte Carlo, where the standard dipole is within 1-2%.
   const Medium<double> medium = marble_red();
   const DirectionalDipole<double> dd(medium);

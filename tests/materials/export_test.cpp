@@ -13,8 +13,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "lucent/core/error.h"
 #include "lucent/materials/dipole.h"
-#include "lucent/materials/error.h"
 #include "lucent/materials/export.h"
 #include "lucent/materials/material.h"
 

@@ -8,8 +8,8 @@ namespace lucent::materials {
 namespace {
 
 // Marble, red channel (Jensen et al. 2001): sigma_a = 0.0021, sigma_s' = 2.19 mm^-1, eta = 1.5.
-// Each expected value is worked out from the DESIGN §4 formulas by hand (see the comment beside
-// it).
+// Each expected value is worked out from the docs/DESIGN.md §4 formulas by hand (see the comment
+// beside it).
 TEST(DiffusionCoefficients, MarbleRedByHand) {
   const auto c = derive_coefficients(Medium<double>::from_reduced(0.0021, 2.19, 1.5));
   EXPECT_DOUBLE_EQ(c.sigma_s_reduced, 2.19);

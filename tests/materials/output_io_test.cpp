@@ -14,9 +14,9 @@
 #include <string>
 #include <vector>
 
-#include "lucent/materials/atomic_file.h"
-#include "lucent/materials/error.h"
-#include "lucent/materials/json_file.h"
+#include "lucent/core/atomic_file.h"
+#include "lucent/core/error.h"
+#include "lucent/core/json_file.h"
 
 namespace lucent {
 namespace {

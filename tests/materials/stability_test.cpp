@@ -1,5 +1,5 @@
-// The extremes of DESIGN §4: no NaN or Inf anywhere on a sweep of 10^6 configurations, and float
-// (the shaders' twin) against double.
+// The extremes of docs/DESIGN.md §4: no NaN or Inf anywhere on a sweep of 10^6 configurations, and
+// float (the shaders' twin) against double.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -12,7 +12,7 @@
 #include <cstdio>
 #include <random>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 #include "lucent/materials/material.h"
 #include "lucent/materials/profile_table.h"
 #include "lucent/materials/radial_slices.h"

@@ -1,12 +1,13 @@
-// Area lights (seed 002) in the renderers: the GLSL form factor (render/shaders/form_factor.glsl)
-// held to the C++ (polygon_form_factor.h) on thousands of configurations; a wide slab under a
-// large parallel rect against its truth, for the reference and the radiance maps; maps against
-// the reference on a sphere lit by a rect (soft shadows, penumbra).
+// Area lights (Jacob 1993) in the renderers: the GLSL form factor
+// (render/gl/shaders/form_factor.glsl) held to the C++ (polygon_form_factor.h) on thousands of
+// configurations; a wide slab under a large parallel rect against its truth, for the reference and
+// the radiance maps; maps against the reference on a sphere lit by a rect (soft shadows, penumbra).
 //
 // The slab's truth: on a plane, the radiance at the lit face's centre x_0 for a radial model is
 //
 //   L(x_0) = (1 / pi) integral over the face of E_t(x) P(|x - x_0|) dA,
-//   E_t(x) = L_rect integral over the rect's solid angle from x of F_t(eta, cos theta) cos theta dw,
+//   E_t(x) = L_rect integral over the rect's solid angle from x of F_t(eta, cos theta) cos theta
+//   dw,
 //
 // P the model's normal-incidence profile of pi L per unit power entering (slab_scene.h). E_t is a
 // midpoint quadrature over the rect (cells 2 mm, 30 mm away), the face integral a trapezoid in

@@ -1,5 +1,5 @@
-// Tests of render/src/environment.cpp: lat-long conventions, loading, and the importance-sampled
-// directional lights (seed 003 §4.4, §5.5.3).
+// Tests of render/core/environment.cpp: lat-long conventions, loading, and the importance-sampled
+// directional lights (Dal Corso 2014 §4.4, §5.5.3).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -9,8 +9,8 @@
 #include <numbers>
 #include <string>
 
+#include "lucent/core/error.h"
 #include "lucent/imaging/image_io.h"
-#include "lucent/materials/error.h"
 #include "lucent/render/environment.h"
 
 namespace lucent::render {

@@ -16,12 +16,12 @@
 #include <filesystem>
 #include <string>
 
-#include "lucent/materials/error.h"
+#include "gl_fixture.h"
+#include "lucent/core/error.h"
 #include "lucent/materials/material.h"
 #include "lucent/render/image_compare.h"
 #include "lucent/render/radiance_maps.h"
 #include "lucent/render/reference_renderer.h"
-#include "gl_fixture.h"
 
 namespace lucent::render {
 namespace {

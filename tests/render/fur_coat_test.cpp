@@ -1,8 +1,9 @@
-// A fur coat over the skin (render/include/lucent/render/fur_coat.h, an extension of seed 001):
-// its transmittance T(mu) against Beer-Lambert for a homogeneous coat, against the tile's own SH
-// transfer for real hairs, and the renders (the reference and the maps) on the large slab against
-// the closed form times exp(-tau / mu), at normal and oblique light; the hierarchical technique's
-// subsurface term and the specular lobe (reference, maps, hierarchical) lit through the coat too.
+// A fur coat over the skin (render/include/lucent/render/fur_coat.h, an extension of Klotzli &
+// Olano): its transmittance T(mu) against Beer-Lambert for a homogeneous coat, against the tile's
+// own SH transfer for real hairs, and the renders (the reference and the maps) on the large slab
+// against the closed form times exp(-tau / mu), at normal and oblique light; the hierarchical
+// technique's subsurface term and the specular lobe (reference, maps, hierarchical) lit through the
+// coat too.
 #include <gtest/gtest.h>
 
 #include <cmath>

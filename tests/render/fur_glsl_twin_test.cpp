@@ -1,4 +1,4 @@
-// The fur's GLSL against its C++ (seed 001 and our coat extension): fur_shade.glsl's 25-term
+// The fur's GLSL against its C++ (Klotzli & Olano and our coat extension): fur_shade.glsl's 25-term
 // reconstruction from the packed transfer texture (fur_gl.h) against fur::shade on thousands of
 // (voxel, light) configurations, and fur_coat.glsl against FurCoat::at; the vertex frames and the
 // lights' SH in them (fur_renderer.h); fur over a sphere finite, non-black, deterministic and

@@ -1,4 +1,4 @@
-// render/include/lucent/render/fur_renderer.h (seed 001 on OpenGL): the tile renders finite,
+// render/include/lucent/render/fur_renderer.h (Klotzli & Olano on OpenGL): the tile renders finite,
 // non-black and deterministic for a seed under every light type; the lights' SH projection.
 #include "lucent/render/fur_renderer.h"
 
@@ -8,7 +8,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 #include "lucent/materials/material.h"
 #include "lucent/render/area_light.h"
 #include "lucent/render/gl_context.h"

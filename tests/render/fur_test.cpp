@@ -1,7 +1,7 @@
-// render/include/lucent/render/fur.h (seed 001 on the CPU): exact hair cross-sections against
-// geometry, the seed's chord and wedge approximations measured, eq. 4's transmittance against
-// closed forms, the precomputed transfer against direct relighting, mirror symmetry (the seed's
-// "brighter from one side" defect) and determinism.
+// render/include/lucent/render/fur.h (Klotzli & Olano on the CPU): exact hair cross-sections
+// against geometry, the seed's chord and wedge approximations measured, eq. 4's transmittance
+// against closed forms, the precomputed transfer against direct relighting, mirror symmetry (the
+// seed's "brighter from one side" defect) and determinism.
 #include "lucent/render/fur.h"
 
 #include <gtest/gtest.h>

@@ -28,10 +28,10 @@ lucent_add_test(fur_glsl_twin_test
 lucent_add_test(area_light_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/area_light_test.cpp
   LIBS lucent::render lucent::materials OpenGL::OpenGL)
-# White-box: both include headers from render/src (gl_program.h, gl_bssrdf.h,
+# White-box: both include private headers of render/ (gl_program.h, gl_bssrdf.h,
 # radiance_maps_sampling.h).
 foreach(t glsl_twin_test radiance_maps_test sh_renderer_test area_light_test fur_glsl_twin_test)
-  target_include_directories(${t} PRIVATE ${PROJECT_SOURCE_DIR}/render/src)
+  target_include_directories(${t} PRIVATE ${LUCENT_RENDER_PRIVATE_DIRS})
 endforeach()
 lucent_add_test(hierarchical_renderer_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/hierarchical_renderer_test.cpp

@@ -1,7 +1,8 @@
-// The GLSL BSSRDFs (render/shaders/bssrdf_ddipole.glsl, bssrdf_dipole.glsl, fresnel.glsl) against
-// the C++ models in double (materials/include/lucent/materials/directional_dipole.h, dipole.h,
-// fresnel.h): evaluated in a compute shader on 20,000 random configurations over realistic media
-// and geometry, front- and back-lit. Skipped when no headless OpenGL 4.5 context can be created.
+// The GLSL BSSRDFs (render/techniques/maps/shaders/bssrdf_ddipole.glsl, bssrdf_dipole.glsl,
+// fresnel.glsl) against the C++ models in double
+// (materials/include/lucent/materials/directional_dipole.h, dipole.h, fresnel.h): evaluated in a
+// compute shader on 20,000 random configurations over realistic media and geometry, front- and
+// back-lit. Skipped when no headless OpenGL 4.5 context can be created.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -175,7 +176,8 @@ double ddipole_float(const Config& c) {
 }
 
 // The two sources of S_d = S'_real - S'_virtual in the plain form of the authors' sample code
-// (DESIGN §4.1), in long double: only to measure how much the difference cancels. cancellation =
+// (docs/DESIGN.md §4.1), in long double: only to measure how much the difference cancels.
+// cancellation =
 // (|S'_real|
 // + |S'_virtual|) / |S_d| multiplies every rounding made before the subtraction; no float
 // formulation of S_d can do better than about eps times it near the zero crossing (where it is

@@ -1,8 +1,8 @@
-// The semi-analytic form factor of seed 004 against quadratures that do not share its edge
+// The semi-analytic form factor of Mertens et al. against quadratures that do not share its edge
 // expansion: (1) polar about the pole, the radial integral analytic and the angular one by adaptive
 // Gauss-Legendre to 1e-13 (what the issue asks for; only the exact r-integration is shared), and
-// (2) a plain 2D cubature of R_d over the triangle (conical Gauss product rules on 4^5 sub-triangles),
-// which shares nothing but the dipole formula.
+// (2) a plain 2D cubature of R_d over the triangle (conical Gauss product rules on 4^5
+// sub-triangles), which shares nothing but the dipole formula.
 #include "lucent/render/hbe_form_factor.h"
 
 #include <gtest/gtest.h>

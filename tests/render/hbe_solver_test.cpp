@@ -9,8 +9,8 @@
 #include <numbers>
 #include <vector>
 
+#include "lucent/core/error.h"
 #include "lucent/materials/dipole.h"
-#include "lucent/materials/error.h"
 #include "lucent/materials/material.h"
 #include "lucent/render/area_light.h"
 

@@ -1,7 +1,8 @@
-// The hierarchical boundary-element technique on the GPU (render/src/hierarchical_renderer.cpp,
-// render/shaders/hbe.*): against the CPU reference with the same R_d (the standard dipole of the
-// chord distance), finiteness and determinism, and a deforming mesh and a material change
-// reaching the image. Skipped without headless OpenGL 4.5.
+// The hierarchical boundary-element technique on the GPU
+// (render/techniques/hierarchical/hierarchical_renderer.cpp,
+// render/techniques/hierarchical/shaders/hbe.*): against the CPU reference with the same R_d (the
+// standard dipole of the chord distance), finiteness and determinism, and a deforming mesh and a
+// material change reaching the image. Skipped without headless OpenGL 4.5.
 #include <gtest/gtest.h>
 
 #include <cmath>

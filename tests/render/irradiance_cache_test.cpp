@@ -1,4 +1,4 @@
-// render/src/irradiance_cache.h: Jacob's per-cluster projection maps of area-light irradiance
+// render/core/irradiance_cache.h: Jacob's per-cluster projection maps of area-light irradiance
 // against direct evaluation at the same points (area_light_irradiance.h with the same shadow
 // rays), on a sphere under a rect (curved clusters, the terminator where the rect straddles the
 // horizon) and on a box beside a second box (a cast shadow: penumbrae); and in the reference.

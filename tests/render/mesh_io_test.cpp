@@ -7,7 +7,7 @@
 #include <sstream>
 #include <string>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 #include "lucent/render/mesh_io.h"
 
 namespace lucent::render {

@@ -10,7 +10,7 @@
 #include <random>
 #include <vector>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 #include "lucent/render/area_light.h"
 #include "lucent/render/polygon_form_factor.h"
 #include "lucent/render/scene.h"

@@ -1,9 +1,9 @@
-// Tests of the radiance-map technique (render/src/radiance_maps*.cpp, render/shaders/): the CPU
-// sampling (Halton points, the biased disc and its weights, the blur schedule) directly, then the
-// OpenGL pipeline on tiny renders (48-64 px, K = 8 directions, N = 8-16 samples, 64-texel maps; on
-// llvmpipe a frame costs ~0.1 s): physical sanity, linearity, accumulation stopping at T frames,
-// and the error against the CPU reference. The GL tests skip themselves where no headless
-// OpenGL 4.5 context can be made.
+// Tests of the radiance-map technique (render/techniques/maps/radiance_maps*.cpp,
+// render/techniques/maps/shaders/): the CPU sampling (Halton points, the biased disc and its
+// weights, the blur schedule) directly, then the OpenGL pipeline on tiny renders (48-64 px, K = 8
+// directions, N = 8-16 samples, 64-texel maps; on llvmpipe a frame costs ~0.1 s): physical sanity,
+// linearity, accumulation stopping at T frames, and the error against the CPU reference. The GL
+// tests skip themselves where no headless OpenGL 4.5 context can be made.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -19,8 +19,9 @@
 #include <string>
 #include <vector>
 
+#include "gl_fixture.h"
+#include "lucent/core/error.h"
 #include "lucent/imaging/image_io.h"
-#include "lucent/materials/error.h"
 #include "lucent/materials/fresnel.h"
 #include "lucent/materials/material.h"
 #include "lucent/render/gl_context.h"
@@ -28,7 +29,6 @@
 #include "lucent/render/radiance_maps.h"
 #include "lucent/render/reference_renderer.h"
 #include "radiance_maps_sampling.h"
-#include "gl_fixture.h"
 
 namespace lucent::render {
 namespace {

@@ -1,6 +1,6 @@
-// Tests of render/src/reference_renderer.cpp, the CPU reference: physical sanity (finite, positive,
-// lit side brighter, linear in the light, rotation invariant), the accelerations against brute
-// force, and convergence as 1/sqrt(samples). Images are 32-48 px with a few thousand samples.
+// Tests of render/reference/reference_renderer.cpp, the CPU reference: physical sanity (finite,
+// positive, lit side brighter, linear in the light, rotation invariant), the accelerations against
+// brute force, and convergence as 1/sqrt(samples). Images are 32-48 px with a few thousand samples.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -14,8 +14,8 @@
 
 #include <Eigen/Geometry>
 
+#include "lucent/core/error.h"
 #include "lucent/imaging/image_io.h"
-#include "lucent/materials/error.h"
 #include "lucent/materials/material.h"
 #include "lucent/render/image_compare.h"
 #include "lucent/render/reference_renderer.h"

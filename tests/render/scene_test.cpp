@@ -1,4 +1,4 @@
-// Tests of render/src/scene.cpp and render/src/mesh_loading.cpp: meshes (built-in, files, data
+// Tests of render/core/scene.cpp and render/core/mesh_loading.cpp: meshes (built-in, files, data
 // cache), lights from the command line, the orbit camera.
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -12,7 +12,7 @@
 #include <optional>
 #include <string>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 #include "lucent/render/scene.h"
 
 namespace lucent::render {

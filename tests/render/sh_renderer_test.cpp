@@ -1,8 +1,9 @@
-// The SH fast translucency technique on the GPU (render/src/sh_renderer.cpp, render/shaders/sh_*):
-// the GLSL twin of sh_translucency.h, the GPU projection against the CPU one (a constant, a linear
-// function, a rendered cube map), the thickness pass against the analytic chord of a sphere,
-// finiteness, determinism, deforming meshes, and the image against the CPU reference after a
-// best-fit scale (the technique is not physically based). Skipped without headless OpenGL 4.5.
+// The SH fast translucency technique on the GPU (render/techniques/sh/sh_renderer.cpp,
+// render/techniques/sh/shaders/sh_*): the GLSL twin of sh_translucency.h, the GPU projection
+// against the CPU one (a constant, a linear function, a rendered cube map), the thickness pass
+// against the analytic chord of a sphere, finiteness, determinism, deforming meshes, and the image
+// against the CPU reference after a best-fit scale (the technique is not physically based). Skipped
+// without headless OpenGL 4.5.
 #include <gtest/gtest.h>
 
 #include <algorithm>

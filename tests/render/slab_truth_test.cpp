@@ -7,10 +7,10 @@
 // P the model's normal-incidence radial profile of pi L along the normal per unit power entering
 // (materials::radial_profile_value, quantity radiance: the dipole R_d F_t(1), the directional
 // dipole pi S_d F_t(1), the tabulated model the transport table's radiance), which for the standard
-// dipole is the closed form F_t(1)^2 E R_tot / pi of DESIGN §4 up to the face's finite extent. The
-// integral over the square face is done here by quadrature in polar coordinates (the part beyond
-// the square is reported; the closed-form R_tot checks the quadrature). Both techniques, every
-// model, two light/radiance-map texel sizes, both several mean free paths wide.
+// dipole is the closed form F_t(1)^2 E R_tot / pi of docs/DESIGN.md §4 up to the face's finite
+// extent. The integral over the square face is done here by quadrature in polar coordinates (the
+// part beyond the square is reported; the closed-form R_tot checks the quadrature). Both
+// techniques, every model, two light/radiance-map texel sizes, both several mean free paths wide.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,4 +1,4 @@
-// Tests of render/src/tone_map.cpp: the curve, sRGB encoding, and atomic PNG / EXR output.
+// Tests of render/core/tone_map.cpp: the curve, sRGB encoding, and atomic PNG / EXR output.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -7,8 +7,8 @@
 #include <limits>
 #include <string>
 
+#include "lucent/core/error.h"
 #include "lucent/imaging/image_io.h"
-#include "lucent/materials/error.h"
 #include "lucent/render/tone_map.h"
 
 namespace lucent::render {

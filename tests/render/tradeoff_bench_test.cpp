@@ -1,4 +1,4 @@
-// The speed/accuracy map (`lucent bench tradeoff`, render/src/tradeoff_*.cpp): its Pareto fronts
+// The speed/accuracy map (`lucent bench tradeoff`, render/bench/tradeoff_*.cpp): its Pareto fronts
 // and equal-error interpolation on rows made here, and a tiny sweep through every technique
 // against the converged reference (skipped without headless OpenGL 4.5).
 #include <gtest/gtest.h>
@@ -12,7 +12,7 @@
 #include <sstream>
 #include <string>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 #include "lucent/render/gl_context.h"
 #include "lucent/render/tradeoff_bench.h"
 

@@ -1,4 +1,4 @@
-// Tests of the viewer's controls without a window (render/src/viewer_controls.cpp): the orbit
+// Tests of the viewer's controls without a window (render/viewer/viewer_controls.cpp): the orbit
 // camera's drag and zoom, dragging lights around the object, the sine deformer and the material
 // file watcher.
 #include "lucent/render/viewer_controls.h"

@@ -1,6 +1,6 @@
-// The viewer's script is checked whole before a window opens (render/src/viewer_script.h): numbers
-// outside what the viewer can do are refused by name (`wait 1e30` hung the viewer, `set exposure -5`
-// and `set light_scale 1e30` were taken), and a valid script parses to its actions.
+// The viewer's script is checked whole before a window opens (render/viewer/viewer_script.h):
+// numbers outside what the viewer can do are refused by name (`wait 1e30` hung the viewer, `set
+// exposure -5` and `set light_scale 1e30` were taken), and a valid script parses to its actions.
 #include "viewer_script.h"
 
 #include <gtest/gtest.h>

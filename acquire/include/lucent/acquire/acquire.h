@@ -1,4 +1,5 @@
-// `lucent acquire`: a capture (brackets or an HDR image, DESIGN §2) -> calibrated HDR and profiles.
+// `lucent acquire`: a capture (brackets or an HDR image, docs/DESIGN.md §2) -> calibrated HDR and
+// profiles.
 //
 // Writes into one output folder, whole or not at all: capture.exr (linear float radiance, per
 // second of exposure, dark subtracted; masked pixels 0), profile.json and profile.csv (profile.h)

@@ -1,5 +1,6 @@
-// A camera model that turns a radiance image into exposure brackets (DESIGN §5): exposure times, a
-// response curve, shot and read noise, a black level, 8- or 16-bit quantisation and saturation.
+// A camera model that turns a radiance image into exposure brackets (docs/DESIGN.md §5): exposure
+// times, a response curve, shot and read noise, a black level, 8- or 16-bit quantisation and
+// saturation.
 #pragma once
 
 #include <cstdint>

@@ -1,5 +1,5 @@
-// The capture file ("format": "lucent-capture", "version": 1; DESIGN §3): what was photographed and
-// how.
+// The capture file ("format": "lucent-capture", "version": 1; docs/DESIGN.md §3): what was
+// photographed and how.
 #pragma once
 
 #include <array>

@@ -1,4 +1,5 @@
-// Exposure brackets -> linear HDR radiance with a per-pixel standard error and a mask (DESIGN §5).
+// Exposure brackets -> linear HDR radiance with a per-pixel standard error and a mask
+// (docs/DESIGN.md §5).
 //
 // Each bracket k gives an estimate x_k = (f(v_k) - f(v_dark)) / t_k of the radiance from its code
 // value v_k (f the response: linear, sRGB or recovered by Debevec's method; v_dark the dark frame's

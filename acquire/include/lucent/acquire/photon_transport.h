@@ -1,7 +1,7 @@
 // Monte Carlo photon transport in a homogeneous slab: the ground truth behind `lucent simulate`
-// (DESIGN §5). A pencil beam of unit power enters a flat sample at the origin; per colour channel
-// the simulation records the specular, diffuse-reflected, transmitted and absorbed power, the
-// radial exitance R(r), and an image of the radiance leaving toward an orthographic camera
+// (docs/DESIGN.md §5). A pencil beam of unit power enters a flat sample at the origin; per colour
+// channel the simulation records the specular, diffuse-reflected, transmitted and absorbed power,
+// the radial exitance R(r), and an image of the radiance leaving toward an orthographic camera
 // (next-event estimate at every scattering event). Deterministic for a seed, whatever the number of
 // threads.
 //

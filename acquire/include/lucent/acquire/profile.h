@@ -1,7 +1,7 @@
-// The profile file ("format": "lucent-profile", "version": 1; DESIGN §3): what `lucent acquire`
-// measured around the beam entry point and what `lucent fit` reads. Radial bins always; 2D samples
-// (one per pixel) for oblique incidence. Values are pi L / P per mm^2 (L the exit radiance, P the
-// beam power) when calibrated, pi L in the capture's radiance units otherwise.
+// The profile file ("format": "lucent-profile", "version": 1; docs/DESIGN.md §3): what `lucent
+// acquire` measured around the beam entry point and what `lucent fit` reads. Radial bins always; 2D
+// samples (one per pixel) for oblique incidence. Values are pi L / P per mm^2 (L the exit radiance,
+// P the beam power) when calibrated, pi L in the capture's radiance units otherwise.
 #pragma once
 
 #include <array>

@@ -1,5 +1,5 @@
-// `lucent tabulate`: builds the transport table of the tabulated model (DESIGN §4.2) by "white"
-// Monte Carlo: one absorption-free run per (eta, g) serves every albedo, absorption applied
+// `lucent tabulate`: builds the transport table of the tabulated model (docs/DESIGN.md §4.2) by
+// "white" Monte Carlo: one absorption-free run per (eta, g) serves every albedo, absorption applied
 // afterwards through each path's length (see tabulate.cpp).
 #pragma once
 

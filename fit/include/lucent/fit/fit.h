@@ -1,4 +1,4 @@
-// `lucent fit`: optical coefficients from measured profiles with Ceres (DESIGN §6).
+// `lucent fit`: optical coefficients from measured profiles with Ceres (docs/DESIGN.md §6).
 #pragma once
 
 #include <array>
@@ -21,9 +21,10 @@ struct SlabNodes;
 
 namespace lucent::fit {
 
-/// kTabulated: the transport table (DESIGN §4.2), exact to radiative transfer for radial profiles
-/// at normal incidence and normal view. kAuto: the accurate model the data allows (tabulated for
-/// radial data, the directional dipole for oblique 2D data), then which cheaper model is adequate.
+/// kTabulated: the transport table (docs/DESIGN.md §4.2), exact to radiative transfer for radial
+/// profiles at normal incidence and normal view. kAuto: the accurate model the data allows
+/// (tabulated for radial data, the directional dipole for oblique 2D data), then which cheaper
+/// model is adequate.
 enum class FitModel { kDipole, kDirectionalDipole, kTabulated, kAuto };
 std::string to_string(FitModel model);
 enum class Quality { kFast, kBalanced, kAccurate };

@@ -1,6 +1,6 @@
-// `lucent bench fit`: the fit's speed against its accuracy (DESIGN §8). Each setting (quality,
-// model, derivatives) is run on captures whose truth is known, and its median solve time and
-// parameter errors go to a CSV and a plot of the trade curve.
+// `lucent bench fit`: the fit's speed against its accuracy (docs/DESIGN.md §8). Each setting
+// (quality, model, derivatives) is run on captures whose truth is known, and its median solve time
+// and parameter errors go to a CSV and a plot of the trade curve.
 #pragma once
 
 #include <filesystem>

@@ -1,4 +1,4 @@
-// The standard dipole of Jensen et al. 2001 (seed 004 Table 1, seed 003 §3.4.7).
+// The standard dipole of Jensen et al. 2001 (Mertens et al. Table 1, Dal Corso 2014 §3.4.7).
 #pragma once
 
 #include <cmath>
@@ -12,8 +12,8 @@
 namespace lucent::materials {
 
 /// Total diffuse reflectance of the standard dipole over the whole plane, a closed form in the
-/// reduced albedo alpha' and the boundary term A (DESIGN §4): R_tot = alpha'/2 (1 + e^(-(4/3) A
-/// sqrt(3 (1 - alpha')))) e^(-sqrt(3 (1 - alpha'))).
+/// reduced albedo alpha' and the boundary term A (docs/DESIGN.md §4): R_tot = alpha'/2 (1 +
+/// e^(-(4/3) A sqrt(3 (1 - alpha')))) e^(-sqrt(3 (1 - alpha'))).
 template <typename T>
 T dipole_total_reflectance(T alpha_prime, T A) {
   using std::exp;

@@ -1,6 +1,6 @@
-// The directional dipole of Frisvad, Hachisuka and Kjeldsen 2014 (seed 003 §3.4.8, Appendix B), in
-// the formulation of the authors' sample code as DESIGN §4.1 spells it out. The thesis writes
-// e^(+sigma_tr r) in eqs. 3.7 and 3.10; the exponent is negative.
+// The directional dipole of Frisvad, Hachisuka and Kjeldsen 2014 (Dal Corso 2014 §3.4.8, Appendix
+// B), in the formulation of the authors' sample code as docs/DESIGN.md §4.1 spells it out. The
+// thesis writes e^(+sigma_tr r) in eqs. 3.7 and 3.10; the exponent is negative.
 #pragma once
 
 #include <Eigen/Core>

@@ -30,9 +30,10 @@ T fresnel_transmittance(T cos_i, T eta) {
 }
 
 /// Diffuse (hemispherical, cosine-weighted) Fresnel reflectance seen from inside a medium of
-/// relative index eta. eta >= 1: Jensen et al. 2001's fit (seed 004 Table 1; the thesis, seed 003,
-/// prints 0.0036 for the last coefficient, 0.0636 is right). eta < 1: Egan and Hilgeman's fit for
-/// that range, as used by the same literature; the two meet at eta = 1 within 2e-4.
+/// relative index eta. eta >= 1: Jensen et al. 2001's fit (Mertens et al. Table 1; the thesis, Dal
+/// Corso 2014, prints 0.0036 for the last coefficient, 0.0636 is right). eta < 1: Egan and
+/// Hilgeman's fit for that range, as used by the same literature; the two meet at eta = 1 within
+/// 2e-4.
 template <typename T>
 T diffuse_fresnel_reflectance(T eta) {
   if (eta < T(1)) {
@@ -43,7 +44,7 @@ T diffuse_fresnel_reflectance(T eta) {
 }
 
 /// First Fresnel moment C1(eta) = integral of F_r sin(theta) cos(theta) dtheta over the hemisphere,
-/// F_r seen from inside the medium. Polynomial fits of d'Eon and Irving as given in seed 003
+/// F_r seen from inside the medium. Polynomial fits of d'Eon and Irving as given in Dal Corso 2014
 /// §3.4.8.
 template <typename T>
 T fresnel_moment_C1(T n) {
@@ -60,12 +61,12 @@ T fresnel_moment_C1(T n) {
 }
 
 /// Second Fresnel moment C2(eta) = integral of F_r sin(theta) cos^2(theta) dtheta, F_r seen from
-/// inside. eta >= 1: d'Eon and Irving's fit as given in seed 003 §3.4.8 (within 0.6% in C_E of the
-/// quadrature up to eta 2, 4% at 2.5). Their fit has one branch for every eta, but below 1 it is not
-/// the moment at all (C_E(0.8) = 0.12 where the quadrature gives 0.486, C_E(0.75) < 0): there the
-/// integrand has no total internal reflection and is smooth in mu = cos(theta), so a 16-node
-/// Gauss-Legendre rule of the definition, integral_0^1 F_r(mu, 1 / eta) mu^2 dmu, is exact to 1e-10
-/// (tests/materials/fresnel_test.cpp holds both branches against an adaptive quadrature).
+/// inside. eta >= 1: d'Eon and Irving's fit as given in Dal Corso 2014 §3.4.8 (within 0.6% in C_E
+/// of the quadrature up to eta 2, 4% at 2.5). Their fit has one branch for every eta, but below 1
+/// it is not the moment at all (C_E(0.8) = 0.12 where the quadrature gives 0.486, C_E(0.75) < 0):
+/// there the integrand has no total internal reflection and is smooth in mu = cos(theta), so a
+/// 16-node Gauss-Legendre rule of the definition, integral_0^1 F_r(mu, 1 / eta) mu^2 dmu, is exact
+/// to 1e-10 (tests/materials/fresnel_test.cpp holds both branches against an adaptive quadrature).
 template <typename T>
 T fresnel_moment_C2(T n) {
   if (n < T(1)) {

@@ -1,5 +1,5 @@
 // A material: RGB optical properties plus what produced them, and its file format
-// ("format": "lucent-material", "version": 1; DESIGN §3).
+// ("format": "lucent-material", "version": 1; docs/DESIGN.md §3).
 #pragma once
 
 #include <array>

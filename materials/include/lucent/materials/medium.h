@@ -29,7 +29,7 @@ struct Medium {
   std::string to_string() const;
 };
 
-/// Every coefficient of DESIGN §4 for one channel. Names follow the papers.
+/// Every coefficient of docs/DESIGN.md §4 for one channel. Names follow the papers.
 template <typename T>
 struct DiffusionCoefficients {
   T eta;

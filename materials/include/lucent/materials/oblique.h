@@ -1,9 +1,9 @@
-// The tabulated model at oblique incidence (DESIGN §4.2): one slice of an oblique transport table
-// (transport_table.h; `lucent tabulate --incidence-deg`), the 2D profile of a semi-infinite slab
-// under a pencil beam at a fixed incidence, eta and g, interpolated C1-smoothly in log value over
-// ln rho (cubic Hermite, as the radial model), u = sqrt(1 - alpha') and the azimuth phi from the
-// beam's direction of travel (Catmull-Rom on the wedge centres, continued evenly across 0 and pi,
-// where the profile is symmetric). Templated on the scalar so that ceres::Jet carries exact
+// The tabulated model at oblique incidence (docs/DESIGN.md §4.2): one slice of an oblique transport
+// table (transport_table.h; `lucent tabulate --incidence-deg`), the 2D profile of a semi-infinite
+// slab under a pencil beam at a fixed incidence, eta and g, interpolated C1-smoothly in log value
+// over ln rho (cubic Hermite, as the radial model), u = sqrt(1 - alpha') and the azimuth phi from
+// the beam's direction of travel (Catmull-Rom on the wedge centres, continued evenly across 0 and
+// pi, where the profile is symmetric). Templated on the scalar so that ceres::Jet carries exact
 // derivatives in the coefficients; the position is data (double).
 //
 // Single scattering: in the radiance along the normal the beam's first scattering is a line on

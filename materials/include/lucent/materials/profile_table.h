@@ -12,8 +12,8 @@
 
 namespace lucent::materials {
 
-/// The models of a translucent material. kTabulated (the transport table, DESIGN §4.2) is radial
-/// only: normal incidence on a plane; the renderer has the two dipoles.
+/// The models of a translucent material. kTabulated (the transport table, docs/DESIGN.md §4.2) is
+/// radial only: normal incidence on a plane; the renderer has the two dipoles.
 enum class DiffusionModel { kDipole, kDirectionalDipole, kTabulated };
 
 /// "dipole" or "ddipole" (and "tabulated" when allowed); anything else throws lucent::Error

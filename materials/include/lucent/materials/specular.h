@@ -1,7 +1,7 @@
 // The surface's own reflection of a light (the specular lobe every light gets, `--roughness`): a
 // dielectric interface with GGX microfacets (Walter, Marschner, Li and Torrance 2007), the exact
 // unpolarised Fresnel reflectance at the microfacet, Smith's separable shadowing. Templated on the
-// scalar; render/shaders/specular.glsl is its GLSL twin.
+// scalar; render/gl/shaders/specular.glsl is its GLSL twin.
 #pragma once
 
 #include <cmath>

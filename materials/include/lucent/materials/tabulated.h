@@ -1,6 +1,6 @@
-// The tabulated model (DESIGN §4.2): a transport table interpolated C1-smoothly in log value over
-// log radius, u = sqrt(1 - alpha') and eta, templated on the scalar so that ceres::Jet carries
-// exact derivatives of the interpolant through a fit.
+// The tabulated model (docs/DESIGN.md §4.2): a transport table interpolated C1-smoothly in log
+// value over log radius, u = sqrt(1 - alpha') and eta, templated on the scalar so that ceres::Jet
+// carries exact derivatives of the interpolant through a fit.
 #pragma once
 
 #include <algorithm>
@@ -397,8 +397,8 @@ class TabulatedModel {
     return scale_ * exp(profile_->row_log_value(row, rho > floor ? rho : floor));
   }
   /// S_d per mm^2 per sr without the two Fresnel transmittances, as the renderers use the model
-  /// (DESIGN §4.2): pi L along the normal / (pi F_t(eta, 1)), so that times the outgoing F_t it is
-  /// the table's radiance along the normal (`lucent profile --quantity radiance`).
+  /// (docs/DESIGN.md §4.2): pi L along the normal / (pi F_t(eta, 1)), so that times the outgoing
+  /// F_t it is the table's radiance along the normal (`lucent profile --quantity radiance`).
   T S_d(T r_mm) const {
     if (!(alpha_prime_ > T(0))) return T(0);
     const T rho = r_mm * sigma_t_reduced_;

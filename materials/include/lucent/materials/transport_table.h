@@ -1,4 +1,4 @@
-// The transport table behind the `tabulated` model (DESIGN §4.2): the radial profile of a
+// The transport table behind the `tabulated` model (docs/DESIGN.md §4.2): the radial profile of a
 // semi-infinite slab under a normally incident pencil beam, from lucent's Monte Carlo simulator,
 // in optical units (radius times sigma_t', reduced albedo alpha') per relative index eta and
 // Henyey-Greenstein g. This header is the data and its file; `tabulated.h` interpolates it.
@@ -11,7 +11,7 @@
 // version, units, grid, photons and seed per slice, payload layout and its CRC-32), a newline, then
 // the payload: little-endian binary, per slice in order, per quantity (exitance, radiance), a
 // float32 value and a uint8 standard-error code per (u, rho) entry, then float64 totals. Binary
-// because the shipped table must stay small in git (DESIGN §4.2; the JSON header keeps it
+// because the shipped table must stay small in git (docs/DESIGN.md §4.2; the JSON header keeps it
 // self-describing); a `partial` file from `lucent tabulate --shard` holds per-group sums instead.
 #pragma once
 

@@ -1,4 +1,4 @@
-// Polygonal area lights (seed 002): construction, validation and sampling of the emitting polygon
+// Polygonal area lights (Jacob 1993): construction, validation and sampling of the emitting polygon
 // of a Light of type kArea (scene.h). Every technique evaluates the exact irradiance pi L F with
 // polygon_form_factor.h; these helpers give the geometry and the stratified points on the polygon
 // that the shadow rays (reference) and the per-frame light maps (radiance maps) use.

@@ -1,6 +1,6 @@
 // Environment maps: a latitude-longitude (equirectangular) image of the radiance arriving from
 // every direction, shown as the background and turned into a few directional lights by importance
-// sampling its luminance (seed 003 §4.4 and §5.5.3; DESIGN §7.1 "Lights").
+// sampling its luminance (Dal Corso 2014 §4.4 and §5.5.3; docs/DESIGN.md §7.1 "Lights").
 //
 // Direction convention (y up, as the mesh and the orbit camera): pixel column u in [0, 1) runs over
 // the azimuth phi = 2 pi u, pixel row v in [0, 1] (v = 0 the top row) over the polar angle
@@ -47,15 +47,15 @@ Vec2f latlong_coordinates(const Vec3f& direction);
 Vec3f environment_lookup(const EnvironmentMap& map, const Vec3f& direction);
 
 /// `count` directional lights that stand for the whole map: directions importance-sampled from the
-/// luminance (Rec. 709) times each texel's solid angle (the sin(theta) correction of seed 003 §4.4,
-/// integrated exactly over the texel's row), marginal over rows then conditional within the row
-/// (seed 003 §5.5.3), at the points of a 2D Halton sequence (bases 2, 3) shifted by a random offset
-/// drawn from `seed` (Cranley-Patterson rotation: stratified, so a few lights are stable). Within a
-/// texel the direction is uniform in solid angle. Each light's radiance is L(direction) /
-/// (count * pdf(direction)), pdf over the sphere (per sr) = p(u, v) / (2 pi^2 sin theta) in the
-/// limit of small texels, so that sum_k radiance_k f(direction_k) estimates the integral of L f
-/// over the sphere for any f (a constant map of radiance 1 gives lights summing to 4 pi). An
-/// all-black map gives no lights.
+/// luminance (Rec. 709) times each texel's solid angle (the sin(theta) correction of Dal Corso 2014
+/// §4.4, integrated exactly over the texel's row), marginal over rows then conditional within the
+/// row (Dal Corso 2014 §5.5.3), at the points of a 2D Halton sequence (bases 2, 3) shifted by a
+/// random offset drawn from `seed` (Cranley-Patterson rotation: stratified, so a few lights are
+/// stable). Within a texel the direction is uniform in solid angle. Each light's radiance is
+/// L(direction) / (count * pdf(direction)), pdf over the sphere (per sr) = p(u, v) / (2 pi^2 sin
+/// theta) in the limit of small texels, so that sum_k radiance_k f(direction_k) estimates the
+/// integral of L f over the sphere for any f (a constant map of radiance 1 gives lights summing to
+/// 4 pi). An all-black map gives no lights.
 std::vector<Light> environment_lights(const EnvironmentMap& map, int count, std::uint64_t seed = 1);
 
 }  // namespace lucent::render

@@ -1,7 +1,7 @@
-// Beyond seed 001 (an extension of ours): a fur coat over a translucent mesh (peach fuzz, velvet,
-// hairy skin). The hairs above the skin shadow the light that enters it; the BSSRDF then spreads
-// that light over a mean free path or more, far wider than a hair, so what reaches the profile is
-// the coat's transmittance averaged over the skin's texels and the light's azimuth,
+// Beyond Klotzli & Olano (an extension of ours): a fur coat over a translucent mesh (peach fuzz,
+// velvet, hairy skin). The hairs above the skin shadow the light that enters it; the BSSRDF then
+// spreads that light over a mean free path or more, far wider than a hair, so what reaches the
+// profile is the coat's transmittance averaged over the skin's texels and the light's azimuth,
 //
 //   T(mu) = < T(p, d) >,  p on the bottom shell, d at cos theta = mu to the normal (fur.h eq. 4),
 //

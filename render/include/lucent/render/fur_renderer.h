@@ -1,7 +1,7 @@
-// `--technique fur --mesh tile` (seed 001, Klotzli and Olano) on OpenGL 4.5: the fur tile of fur.h
-// (hairs, cross-sections, transfer precomputed on the CPU at setup) drawn as stacked shells, the
-// lights projected onto the 25 real SH each frame and the per-fragment 25-term dot product with the
-// shell's transfer (7 RGBA layers per shell), shells alpha-blended back to front over the skin.
+// `--technique fur --mesh tile` (Klotzli & Olano, Klotzli and Olano) on OpenGL 4.5: the fur tile of
+// fur.h (hairs, cross-sections, transfer precomputed on the CPU at setup) drawn as stacked shells,
+// the lights projected onto the 25 real SH each frame and the per-fragment 25-term dot product with
+// the shell's transfer (7 RGBA layers per shell), shells alpha-blended back to front over the skin.
 //
 // Shading: the light reaching a voxel, integral L(w) T(w) dw = sum_i c_i t_i (the seed's lighting
 // model: no hair BRDF), scattered isotropically by hairs of the material's reduced albedo:
@@ -67,15 +67,15 @@ class FurRenderer {
 };
 
 /// One frame in a headless context (stats: technique "fur", precompute and draw times). On the
-/// tile, seed 001; on any other mesh, the extension: `skin` (the radiance maps' settings) renders
-/// the BSSRDF under the coat (scene.fur_coat, or the tile's own coat_transmittance), then the
-/// shells are drawn over it (fur_mesh.cpp).
+/// tile, Klotzli & Olano; on any other mesh, the extension: `skin` (the radiance maps' settings)
+/// renders the BSSRDF under the coat (scene.fur_coat, or the tile's own coat_transmittance), then
+/// the shells are drawn over it (fur_mesh.cpp).
 ImageRgb render_fur(const Scene& scene, const fur::FurOptions& options, RenderStats* stats = nullptr,
                     const RenderSettings& skin = {});
 
-/// Fur shells over a mesh (the extension of seed 001): `render_fur` for meshes other than the
-/// tile. Shells at (s + 0.5) height_mm / shells along the vertex normals, the tile mapped by its
-/// width tile_mm onto the surface by triplanar projection (weights |n_a|^4), the lights' SH
+/// Fur shells over a mesh (the extension of Klotzli & Olano): `render_fur` for meshes other than
+/// the tile. Shells at (s + 0.5) height_mm / shells along the vertex normals, the tile mapped by
+/// its width tile_mm onto the surface by triplanar projection (weights |n_a|^4), the lights' SH
 /// evaluated per vertex in fur_vertex_frame and interpolated, alpha-blended inner to outer over
 /// the skin image, which the mesh's depth occludes. No mesh-scale shadows on the hairs (the skin
 /// has them: it comes from the maps).

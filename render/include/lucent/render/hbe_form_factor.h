@@ -1,17 +1,17 @@
-// The subsurface form factor of seed 004 (Mertens et al. 2003, §4): the integral of the standard
-// dipole's R_d(x_i, x_o) over a planar polygon A, F(A, x_o) = integral over A of R_d dx_i (mm^-2 x
-// mm^2: dimensionless), so that B(x_o) = sum_k E_k F(A_k, x_o).
+// The subsurface form factor of Mertens et al. (Mertens et al. 2003, §4): the integral of the
+// standard dipole's R_d(x_i, x_o) over a planar polygon A, F(A, x_o) = integral over A of R_d dx_i
+// (mm^-2 x mm^2: dimensionless), so that B(x_o) = sum_k E_k F(A_k, x_o).
 //
-// Each source of the dipole (prefactor z, at height H above the polygon's plane, its foot the "pole"
-// p in that plane) contributes I = integral over A of z (1 + sigma s) e^(-sigma s) / s^3 dx,
-// s^2 = |x - p|^2 + H^2, sigma = sigma_tr. In polar coordinates about p the radial integral is exact
-// (d/ds of -e^(-sigma s) / s is (1 + sigma s) e^(-sigma s) / s^2, and s ds = r dr), and what remains
-// is a sum over the polygon's oriented edges of
+// Each source of the dipole (prefactor z, at height H above the polygon's plane, its foot the
+// "pole" p in that plane) contributes I = integral over A of z (1 + sigma s) e^(-sigma s) / s^3 dx,
+// s^2 = |x - p|^2 + H^2, sigma = sigma_tr. In polar coordinates about p the radial integral is
+// exact (d/ds of -e^(-sigma s) / s is (1 + sigma s) e^(-sigma s) / s^2, and s ds = r dr), and what
+// remains is a sum over the polygon's oriented edges of
 //   Gamma_e = I1 - I2,  I1 = z e^(-sigma H) / H dtheta_e,
 //   I2 = z R integral over the edge of e^(-sigma s) / (s (R^2 + t^2)) dt        (eqs. 10-13),
 // with dtheta_e the signed angle the edge subtends at p and R the signed distance from p to the
-// edge's line. The text's "I_e = I1 + I2" is a misprint (eq. 10 subtracts), eq. 18 sums the real and
-// the virtual source (I'_a + I''_a), and eq. 16's first-order term misses a factor 1/2 (it only
+// edge's line. The text's "I_e = I1 + I2" is a misprint (eq. 10 subtracts), eq. 18 sums the real
+// and the virtual source (I'_a + I''_a), and eq. 16's first-order term misses a factor 1/2 (it only
 // matters beyond the midpoint rule). Shared edges of coplanar faces cancel, so a cluster's form
 // factor is its boundary's edge sum.
 //

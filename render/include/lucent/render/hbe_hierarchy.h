@@ -1,4 +1,4 @@
-// The face-cluster hierarchy of the hierarchical boundary-element technique (seed 004 §5.1.1,
+// The face-cluster hierarchy of the hierarchical boundary-element technique (Mertens et al. §5.1.1,
 // option 1): built bottom-up by merging neighbouring clusters, the measure only compactness (the
 // seed ignores curvature when building and checks planarity, A' / A, when linking, since geometry
 // and curvature change at run time). Finer clusters are embedded in coarser ones: each cluster is

@@ -1,4 +1,4 @@
-// The hierarchical boundary-element technique (`--technique hierarchical`, seed 004: Mertens,
+// The hierarchical boundary-element technique (`--technique hierarchical`, Mertens et al.: Mertens,
 // Kautz, Bekaert, Seidel, Van Reeth 2003). B(x_o) = integral of E(x_i) R_d(x_i, x_o) dx_i is
 // solved on a face-cluster hierarchy (hbe_hierarchy.h) in the manner of hierarchical radiosity:
 //   links: from the root to itself, refined by a solid-angle oracle (below);
@@ -60,8 +60,8 @@ struct Options {
   Mode mode = Mode::kRender;
   long budget = 200000;  ///< kIncremental: link factors evaluated per frame (3 channels each)
   bool shadows = true;   ///< shadow rays from the leaves' midpoints toward each light
-  /// Area lights: leaf irradiance from the per-cluster projection maps of seed 002 (built once
-  /// per light set and geometry, looked up every frame; render/src/irradiance_cache.h), texel
+  /// Area lights: leaf irradiance from the per-cluster projection maps of Jacob 1993 (built once
+  /// per light set and geometry, looked up every frame; render/core/irradiance_cache.h), texel
   /// the bounding radius / 64; false: 16 shadow rays per leaf every frame.
   bool irradiance_cache = true;
 

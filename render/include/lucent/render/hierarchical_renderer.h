@@ -1,6 +1,7 @@
 // `--technique hierarchical` on OpenGL 4.5: the CPU solve of hierarchical.h each frame (links as
 // its mode keeps them), the per-vertex B uploaded as a vertex attribute, and the fragment shader's
-// (1 / pi) F_t(eta, n . w_o) B plus the lights' specular lobes (render/shaders/hbe.frag).
+// (1 / pi) F_t(eta, n . w_o) B plus the lights' specular lobes
+// (render/techniques/hierarchical/shaders/hbe.frag).
 #pragma once
 
 #include <cstdint>

@@ -1,4 +1,4 @@
-// The point-to-polygon form factor of seed 002 (Jacob 1993, §3; after Lambert's contour formula):
+// The point-to-polygon form factor of Jacob 1993 (Jacob 1993, §3; after Lambert's contour formula):
 // the fraction of the energy leaving a differential receiver dA at x (unit normal n) that reaches
 // a planar polygon, equal by reciprocity to the irradiance at x from the polygon emitting unit
 // radiance, divided by pi:
@@ -26,7 +26,7 @@
 // is |P + t dP|^2 and eq. 18's first arctan argument is (2w + v) / sqrt(4uw - v^2). lucent uses the
 // closed contour sum above, which needs none of them.
 //
-// Templated on the scalar (double on the CPU; render/shaders/form_factor.glsl is the float twin,
+// Templated on the scalar (double on the CPU; render/gl/shaders/form_factor.glsl is the float twin,
 // held to this file by tests/render/glsl_twin_test.cpp).
 #pragma once
 

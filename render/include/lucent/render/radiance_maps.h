@@ -1,5 +1,5 @@
-// The directional-dipole radiance-map technique (seed 003, Dal Corso 2014, chapters 4-5; DESIGN
-// §7.1 and §7.2) on OpenGL 4.5: per frame,
+// The directional-dipole radiance-map technique (Dal Corso 2014, Dal Corso 2014, chapters 4-5;
+// DESIGN §7.1 and §7.2) on OpenGL 4.5: per frame,
 //   1. light map: positions, normals and depth of the mesh seen from every light (one layer each;
 //      orthographic fitted to the mesh for directional lights, perspective for point lights);
 //   2. radiance maps: the mesh from K Halton directions into a K-layer array in one instanced draw;
@@ -13,7 +13,8 @@
 //      the layer plane against seams), adds the Fresnel-reflected environment, and is read back
 //      linear (or tone-mapped on screen by present()).
 // Units: mm for lengths (the scene's), the lights' radiance units for the result. Deviations from
-// the seed are documented where they are made (render/src/radiance_maps_sampling.h, the shaders).
+// the seed are documented where they are made (render/techniques/maps/radiance_maps_sampling.h, the
+// shaders).
 #pragma once
 
 #include <cstdint>

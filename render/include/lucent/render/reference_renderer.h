@@ -1,6 +1,6 @@
-// The CPU reference (DESIGN §7.5): the BSSRDF integrated over dense surface samples with shadow
-// rays, the yardstick for every real-time technique's error. For each camera pixel that sees the
-// object at x_o (normal n_o, toward the eye w_o):
+// The CPU reference (docs/DESIGN.md §7.5): the BSSRDF integrated over dense surface samples with
+// shadow rays, the yardstick for every real-time technique's error. For each camera pixel that sees
+// the object at x_o (normal n_o, toward the eye w_o):
 //
 //   L(x_o, w_o) = F_t(eta, n_o . w_o) sum_i (A / N) S_d(x_i, n_i, w_i, x_o, n_o) E_i,
 //   E_i = radiance * max(0, n_i . w_i) * V(x_i, light) * F_t(eta, n_i . w_i)
@@ -59,8 +59,8 @@ struct ReferenceOptions {
   /// it a fully visible light costs no noise). The kArea sampler always uses the plain mean.
   int area_light_samples = 4;
   bool area_light_control_variate = true;
-  /// Area lights (kProbes): the irradiance from the per-cluster projection maps of seed 002
-  /// (render/src/irradiance_cache.h: exact form factor and `irradiance_cache_samples` shadow rays
+  /// Area lights (kProbes): the irradiance from the per-cluster projection maps of Jacob 1993
+  /// (render/core/irradiance_cache.h: exact form factor and `irradiance_cache_samples` shadow rays
   /// at grid vertices, bilinear between them) instead of shadow rays at every probe hit: faster,
   /// biased by the interpolation (measured in tests/render/irradiance_cache_test.cpp).
   bool irradiance_cache = false;

@@ -1,5 +1,6 @@
-// `lucent bench render`: per-stage times of the radiance-map technique at the seed's settings on the
-// bunny and the dragon at several resolutions (seed 003, Figure 6.15), to notebooks_data/bench/.
+// `lucent bench render`: per-stage times of the radiance-map technique at the seed's settings on
+// the bunny and the dragon at several resolutions (Dal Corso 2014, Figure 6.15), to
+// notebooks_data/bench/.
 #pragma once
 
 #include <filesystem>
@@ -26,8 +27,8 @@ struct RenderBenchOptions {
 /// Renders each mesh with each disc selection, one row each; returns the rows written.
 int run_render_bench(const RenderBenchOptions& options, std::ostream& log);
 
-/// `lucent bench fur`: the fur tile of seed 001 at the seed's 1280 x 1024 (the seed: 40 fps on
-/// a GeForce 6800 SLI), one row per shell count: the CPU precompute (hairs, cross-sections,
+/// `lucent bench fur`: the fur tile of Klotzli & Olano at the seed's 1280 x 1024 (the seed: 40 fps
+/// on a GeForce 6800 SLI), one row per shell count: the CPU precompute (hairs, cross-sections,
 /// transfer) and the per-frame draw (glFinish and a wall clock; the median of `frames` after a
 /// first, compiling frame), from the render command's default view (30, 20: the tile on part of the
 /// frame) and from close by (the frame filled), with the fraction of pixels the fur covers.

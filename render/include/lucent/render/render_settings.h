@@ -1,6 +1,6 @@
 // What `lucent render` asks of a real-time technique, and what a technique reports back. The CLI
 // fills RenderSettings (and validates it); the radiance-map pipeline (radiance_maps.h) reads it.
-// Defaults are seed 003's (Dal Corso 2014, §6.1 "Parameters": M = 1000, q = 1, K = 16, W_l = 512;
+// Defaults are Dal Corso's (Dal Corso 2014, §6.1 "Parameters": M = 1000, q = 1, K = 16, W_l = 512;
 // results "at convergence (after 100 frames)"); its default radiance-map size W_r = 1024 is halved
 // to 512 here (the thesis' §6.2.3 finds no visible loss down to 256), and N = 50 is a middle value
 // from its Figures 6.3 to 6.15 (N from 10 to 1000).
@@ -40,7 +40,7 @@ enum class DiscDistribution {
   /// density. On a plane the disc sum is then a quadrature of the profile itself at any sigma*,
   /// texel size or mean free path: the near field of short-mean-free-path channels (where most
   /// of the light leaves) is sampled as densely as the far tail, which the exponential disc
-  /// starves (seed 003's e^(-sigma* r) with sigma* = sigma_tr / q puts ~1 of 1000 points
+  /// starves (Dal Corso's e^(-sigma* r) with sigma* = sigma_tr / q puts ~1 of 1000 points
   /// inside marble's mean free path).
   kProfile,
   /// Seed 003 §5.3.4.1: Halton points kept with probability e^(-sigma* r), sigma* = min sigma_tr /
@@ -48,7 +48,8 @@ enum class DiscDistribution {
   kExponential,
 };
 
-/// Knobs of the directional-dipole (or standard-dipole) radiance-map technique (DESIGN §7.1, §8).
+/// Knobs of the directional-dipole (or standard-dipole) radiance-map technique (docs/DESIGN.md
+/// §7.1, §8).
 struct RenderSettings {
   DiffusionModel model = DiffusionModel::kDirectionalDipole;  ///< BSSRDF the maps gather with
 

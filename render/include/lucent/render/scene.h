@@ -76,8 +76,9 @@ struct Scene {
   float roughness = 0.1f;
   bool specular = true;  ///< `--specular off` renders the subsurface term alone
   Vec3f backdrop{0, 0, 0};  ///< radiance of the background where no environment map is given
-  /// A fur coat over the skin (fur_coat.h, an extension of seed 001): the maps and the reference
-  /// attenuate each light sample's transmitted irradiance by its T(n . w_i). `--fur-coat on`.
+  /// A fur coat over the skin (fur_coat.h, an extension of Klotzli & Olano): the maps and the
+  /// reference attenuate each light sample's transmitted irradiance by its T(n . w_i). `--fur-coat
+  /// on`.
   std::optional<FurCoat> fur_coat;
 };
 

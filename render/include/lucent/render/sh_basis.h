@@ -1,5 +1,5 @@
 // Real spherical harmonics of bands 0-4 (25 functions) for the fur technique's precomputed radiance
-// transfer (seed 001, Klotzli and Olano, eqs. 5-7), templated on the scalar.
+// transfer (Klotzli & Olano, Klotzli and Olano, eqs. 5-7), templated on the scalar.
 //
 //   Y_l^m = sqrt(2) K_l^m  cos(m phi)  P_l^m(cos theta),      m > 0
 //   Y_l^m = sqrt(2) K_l^|m| sin(|m| phi) P_l^|m|(cos theta),  m < 0

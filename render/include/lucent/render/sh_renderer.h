@@ -1,5 +1,5 @@
-// The spherical-harmonics fast translucency technique (`--technique sh`, seed 000: Banterle and
-// Chalmers 2006) on OpenGL 4.5. Nothing is precomputed per mesh: every frame
+// The spherical-harmonics fast translucency technique (`--technique sh`, Banterle & Chalmers:
+// Banterle and Chalmers 2006) on OpenGL 4.5. Nothing is precomputed per mesh: every frame
 //   1. the primary light's shadow map (distance along its rays, shadow_map_size^2) and one
 //      depth-peeling pass for the second surface; a separable Gaussian blur of the first depth;
 //   2. the external cube map (cube_map_size^2 per face): six orthographic cameras along the axes of

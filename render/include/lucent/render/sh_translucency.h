@@ -2,9 +2,9 @@
 // issue 12), templated on the scalar so that a GLSL twin can be held against it in float.
 //
 // The technique (Banterle and Chalmers 2006, "A Fast Translucency Appearance Model for Real-Time
-// Applications", seed 000): render the lit object into an external cube map centred on its
-// bounding box, project that irradiance onto the 9 real spherical harmonics of bands 0-2 per RGB
-// channel (eq. 6), and shade a surface point x_out with the cosine-lobe convolution of that
+// Applications", Banterle & Chalmers): render the lit object into an external cube map centred on
+// its bounding box, project that irradiance onto the 9 real spherical harmonics of bands 0-2 per
+// RGB channel (eq. 6), and shade a surface point x_out with the cosine-lobe convolution of that
 // projection, looked up along the refracted view direction r, times an attenuation in the
 // thickness d (eqs. 10-12):
 //   L(x_out) = 1/pi F_t(eta, w_out) a(d) B(r),   B(r) = r^T M r.
@@ -37,7 +37,7 @@
 #include <numbers>
 #include <string>
 
-#include "lucent/materials/error.h"
+#include "lucent/core/error.h"
 #include "lucent/materials/medium.h"
 
 namespace lucent::render::sh {

@@ -1,7 +1,7 @@
-// `lucent bench tradeoff`: the speed/accuracy map of every technique (issue 12, DESIGN §8). Each
-// scene (mesh, material, lighting) is rendered by the CPU reference at a converged sample count,
-// then by every technique over a sweep of its knobs; each image's time and its error against the
-// converged reference go to tradeoff.csv, the error-against-time curves to tradeoff.png / .svg,
+// `lucent bench tradeoff`: the speed/accuracy map of every technique (issue 12, docs/DESIGN.md §8).
+// Each scene (mesh, material, lighting) is rendered by the CPU reference at a converged sample
+// count, then by every technique over a sweep of its knobs; each image's time and its error against
+// the converged reference go to tradeoff.csv, the error-against-time curves to tradeoff.png / .svg,
 // and the Pareto fronts and the times relative to the radiance maps at equal error to
 // tradeoff_summary.md.
 #pragma once
@@ -50,7 +50,7 @@ struct TradeoffRow {
   /// What the map plots: relative_rmse, or scaled_rmse for techniques that are right only up to
   /// a scale (sh).
   double error() const;
-  bool scale_only() const { return technique == "sh"; }
+  bool scale_only() const;  ///< the registry's technique is not physically based
 };
 
 /// The rows of one technique (or all, technique empty) not beaten by another row in both time

@@ -1,8 +1,8 @@
 // `lucent view`: the material preview window (GLFW + Dear ImGui, OpenGL 4.5 core). The radiance
 // maps accumulate while nothing changes and restart when something does; the CPU reference can be
 // switched in (progressive passes on worker threads, shown as they finish), and so can the SH fast
-// translucency (seed 000: every pass every frame, nothing accumulated). The difference view (D)
-// holds the current technique against the cached reference of the same view (sh after its
+// translucency (Banterle & Chalmers: every pass every frame, nothing accumulated). The difference
+// view (D) holds the current technique against the cached reference of the same view (sh after its
 // least-squares scale: it is not physically based).
 //
 // Controls: left drag orbits, the wheel zooms, right drag moves the selected light around the
@@ -14,12 +14,13 @@
 
 #include <string>
 
+#include "lucent/render/fur.h"
+#include "lucent/render/hierarchical.h"
 #include "lucent/render/reference_renderer.h"
 #include "lucent/render/render_settings.h"
 #include "lucent/render/scene.h"
-#include "lucent/render/fur.h"
-#include "lucent/render/hierarchical.h"
 #include "lucent/render/sh_renderer.h"
+#include "lucent/render/technique.h"
 #include "lucent/render/viewer_controls.h"
 
 namespace lucent::render {
@@ -32,7 +33,7 @@ struct ViewerOptions {
   ReferenceOptions reference;      ///< surface samples per pass, threads and seed for the reference
   OrbitView view;                  ///< --view
   double object_size_mm = 100;     ///< the mesh's bounding-box diagonal as loaded
-  std::string technique = "maps";  ///< maps | sh | hierarchical | reference
+  TechniqueId technique = TechniqueId::kMaps;
   hbe::Options hbe;                ///< --technique hierarchical: oracle, form factor, mode
   ShOptions sh;                    ///< --technique sh: shadow map, cube map, depth blur, Fresnel
   fur::FurOptions fur;             ///< --technique fur: the tile (--mesh tile)

@@ -1,0 +1,107 @@
+// The technique registry (technique.h): the only place a technique's name is compared.
+#include "lucent/render/technique.h"
+
+#include <algorithm>
+
+#include "lucent/core/error.h"
+#include "lucent/render/fur_renderer.h"
+#include "lucent/render/hierarchical_renderer.h"
+
+namespace lucent::render {
+
+using materials::DiffusionModel;
+
+bool TechniqueInfo::supports(DiffusionModel model) const {
+  return std::find(models.begin(), models.end(), model) != models.end();
+}
+
+const std::vector<TechniqueInfo>& techniques() {
+  const std::vector<DiffusionModel> all = {DiffusionModel::kTabulated,
+                                           DiffusionModel::kDirectionalDipole,
+                                           DiffusionModel::kDipole};
+  static const std::vector<TechniqueInfo> table = {
+      {TechniqueId::kMaps, "maps", "radiance maps", "radiance maps",
+       "maps (real-time radiance maps, OpenGL)", true, all, "", true, true, true},
+      {TechniqueId::kSh, "sh", "SH fast translucency", "SH fast",
+       "sh (spherical-harmonics fast translucency, OpenGL, Banterle & Chalmers: not physically "
+       "based)",
+       false, all, "", true, false, false},
+      {TechniqueId::kHierarchical,
+       "hierarchical",
+       "hierarchical boundary elements",
+       "hierarchical",
+       "hierarchical (boundary elements on a face-cluster hierarchy, Mertens et al.: the standard "
+       "dipole, solved on the CPU, shaded per vertex on the GPU)",
+       true,
+       {DiffusionModel::kDipole},
+       "integrates the standard dipole (Mertens et al.)",
+       true,
+       true,
+       false},
+      {TechniqueId::kFur, "fur", "fur shells with SH transfer", "fur",
+       "fur (Klotzli & Olano: shells with SH transfer; --mesh tile is the seed's tile, other "
+       "meshes get a "
+       "coat of shells over the maps' skin: an extension)",
+       true, all, "", true, true, false},
+      {TechniqueId::kReference, "reference", "CPU reference", "CPU reference",
+       "reference (CPU, slow, exact up to sampling noise)", true, all, "", false, true, false},
+  };
+  return table;
+}
+
+const TechniqueInfo& technique_info(TechniqueId id) {
+  for (const TechniqueInfo& t : techniques())
+    if (t.id == id) return t;
+  throw std::logic_error("technique_info: a technique missing from the registry");
+}
+
+const TechniqueInfo* find_technique(std::string_view name) {
+  for (const TechniqueInfo& t : techniques())
+    if (t.name == name) return &t;
+  return nullptr;
+}
+
+std::string technique_names(const std::function<bool(const TechniqueInfo&)>& which) {
+  std::vector<std::string> names;
+  for (const TechniqueInfo& t : techniques())
+    if (!which || which(t)) names.push_back(t.name);
+  std::string list;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    list += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+  return list;
+}
+
+TechniqueId parse_technique(std::string_view name, const std::string& option) {
+  if (const TechniqueInfo* t = find_technique(name)) return t->id;
+  throw Error(option + ": expected " + technique_names() + ", got '" + std::string(name) + "'");
+}
+
+ImageRgb render_still(TechniqueId id, const Scene& scene, const TechniqueOptions& options,
+                      RenderStats* stats) {
+  switch (id) {
+    case TechniqueId::kReference: {
+      ReferenceImage result = render_reference(scene, options.settings.model, options.reference);
+      if (stats) *stats = std::move(result.stats);
+      return std::move(result.image);
+    }
+    case TechniqueId::kSh: return render_sh(scene, options.sh, stats);
+    case TechniqueId::kHierarchical: return render_hierarchical(scene, options.hbe, stats);
+    case TechniqueId::kFur: return render_fur(scene, options.fur, stats, options.settings);
+    case TechniqueId::kMaps:
+      return render_radiance_maps(scene, options.settings, options.maps, stats, nullptr);
+  }
+  throw std::logic_error("render_still: a technique without a renderer");
+}
+
+std::string settings_text(TechniqueId id, const TechniqueOptions& options) {
+  switch (id) {
+    case TechniqueId::kMaps: return options.settings.to_string();
+    case TechniqueId::kSh: return options.sh.to_string();
+    case TechniqueId::kHierarchical: return options.hbe.to_string();
+    case TechniqueId::kFur:
+    case TechniqueId::kReference: return "";
+  }
+  return "";
+}
+
+}  // namespace lucent::render

@@ -1,0 +1,76 @@
+// The techniques lucent renders with, in one registry: each one's name (the CLI's --technique value,
+// and the prefix of its files and flags), what it is (physically based or right only up to a scale,
+// the diffusion models it integrates, whether it needs OpenGL, whether it takes a fur coat or
+// converges frame by frame) and the one place where a technique is chosen by its name. Adding a
+// technique is its sources plus one line in technique.cpp's table and one case in render_still.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "lucent/materials/profile_table.h"
+#include "lucent/render/fur.h"
+#include "lucent/render/hierarchical.h"
+#include "lucent/render/radiance_maps.h"
+#include "lucent/render/reference_renderer.h"
+#include "lucent/render/render_settings.h"
+#include "lucent/render/scene.h"
+#include "lucent/render/sh_renderer.h"
+
+namespace lucent::render {
+
+enum class TechniqueId { kMaps, kSh, kHierarchical, kFur, kReference };
+
+struct TechniqueInfo {
+  TechniqueId id;
+  std::string name;   ///< --technique's value: maps, sh, hierarchical, fur, reference
+  std::string label;  ///< for people: "radiance maps", "CPU reference", ...
+  std::string panel_label;  ///< the viewer's radio button: "SH fast", ...
+  std::string help;   ///< its clause in --technique's help
+  /// False where the images are right only up to a scale (compare them after the best scale).
+  bool physically_based = true;
+  /// The diffusion models it integrates; `model_note` says why where it is one only.
+  std::vector<materials::DiffusionModel> models;
+  std::string model_note;
+  bool gpu = true;               ///< needs an OpenGL 4.5 context
+  bool fur_coat = true;          ///< renders a fur coat over the skin (--fur-coat on)
+  bool frame_snapshots = false;  ///< converges frame by frame and writes snapshots (--snapshots)
+
+  bool supports(materials::DiffusionModel model) const;
+};
+
+/// Every technique, in the order the help and the viewer list them.
+const std::vector<TechniqueInfo>& techniques();
+const TechniqueInfo& technique_info(TechniqueId id);
+/// The technique called `name`, or nullptr.
+const TechniqueInfo* find_technique(std::string_view name);
+/// The technique called `name`; lucent::Error "OPTION: expected maps, sh, hierarchical, fur or
+/// reference, got 'NAME'" otherwise.
+TechniqueId parse_technique(std::string_view name, const std::string& option = "--technique");
+/// "maps, sh, hierarchical, fur or reference": the names of the techniques `which` accepts (all when
+/// it is empty).
+std::string technique_names(const std::function<bool(const TechniqueInfo&)>& which = {});
+
+/// Every technique's options, as `lucent render` fills them; each technique reads its own (and the
+/// maps' settings carry the model and the exposure every technique uses).
+struct TechniqueOptions {
+  RenderSettings settings;
+  RadianceMapOptions maps;
+  ShOptions sh;
+  hbe::Options hbe;
+  fur::FurOptions fur;
+  ReferenceOptions reference;
+};
+
+/// One still image of `scene` by technique `id`: linear RGB radiance, camera.width x camera.height,
+/// row 0 at the top. Fills `stats` when given.
+ImageRgb render_still(TechniqueId id, const Scene& scene, const TechniqueOptions& options,
+                      RenderStats* stats);
+
+/// The options technique `id` was run with, as text (the render statistics' "settings"); empty
+/// where the technique reports none.
+std::string settings_text(TechniqueId id, const TechniqueOptions& options);
+
+}  // namespace lucent::render

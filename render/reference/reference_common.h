@@ -1,0 +1,292 @@
+// What the CPU reference's two samplers share (reference_renderer.cpp: uniform area samples with
+// clusters; reference_probes.cpp: probe rays importance-sampling the profile around each pixel):
+// threads, counter-based random numbers, the Embree scene, the per-channel BSSRDF, pixel hits.
+#pragma once
+
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <exception>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <numbers>
+#include <thread>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "lucent/core/error.h"
+#include "lucent/materials/dipole.h"
+#include "lucent/materials/directional_dipole.h"
+#include "lucent/materials/fresnel.h"
+#include "lucent/materials/tabulated.h"
+#include "lucent/render/reference_renderer.h"
+#include "lucent/render/scene.h"
+
+namespace lucent::render::detail {
+
+using Vec3d = Eigen::Vector3d;
+using Clock = std::chrono::steady_clock;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+inline double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Threads: work items handed out in chunks from an atomic counter; results never depend on which
+// thread ran what.
+
+inline void parallel_for(std::size_t count, int threads, std::size_t chunk,
+                  const std::function<void(std::size_t, std::size_t)>& body,
+                  const std::function<void(std::size_t)>& on_progress = {}) {
+  std::atomic<std::size_t> next{0}, done{0};
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  const auto work = [&](bool reporter) {
+    try {
+      for (;;) {
+        const std::size_t begin = next.fetch_add(chunk);
+        if (begin >= count) break;
+        const std::size_t end = std::min(count, begin + chunk);
+        body(begin, end);
+        const std::size_t total = done.fetch_add(end - begin) + (end - begin);
+        if (reporter && on_progress) on_progress(total);
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(failure_mutex);
+      if (!failure) failure = std::current_exception();
+      next = count;
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work, false);
+  work(true);
+  for (auto& thread : pool) thread.join();
+  if (failure) std::rethrow_exception(failure);
+}
+
+// Counter-based random numbers: sample k of pass p of seed s is the same whatever thread draws it.
+inline std::uint64_t mix(std::uint64_t z) {
+  z += 0x9E3779B97F4A7C15ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+inline double uniform01(std::uint64_t key) {
+  return double(mix(key) >> 11) * 0x1.0p-53;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Embree scene of the mesh.
+
+class RayScene {
+ public:
+  explicit RayScene(const Mesh& mesh) {
+    device_ = rtcNewDevice("verbose=0");
+    if (!device_) throw Error("reference renderer: cannot create an Embree device");
+    scene_ = rtcNewScene(device_);
+    RTCGeometry geometry = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vertices = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                3 * sizeof(float), mesh.positions.size()));
+    for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+      for (int k = 0; k < 3; ++k) vertices[3 * i + k] = mesh.positions[i][k];
+    }
+    auto* indices = static_cast<unsigned*>(
+        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                3 * sizeof(unsigned), mesh.triangles.size()));
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      for (int k = 0; k < 3; ++k) indices[3 * t + k] = mesh.triangles[t][k];
+    }
+    rtcCommitGeometry(geometry);
+    rtcAttachGeometry(scene_, geometry);
+    rtcReleaseGeometry(geometry);
+    rtcCommitScene(scene_);
+  }
+  ~RayScene() {
+    rtcReleaseScene(scene_);
+    rtcReleaseDevice(device_);
+  }
+  RayScene(const RayScene&) = delete;
+  RayScene& operator=(const RayScene&) = delete;
+
+  /// Nearest hit: triangle index and Embree's barycentrics (u, v) of vertices 1 and 2; false if
+  /// none.
+  bool intersect(const Vec3f& origin, const Vec3f& direction, unsigned& triangle, float& u,
+                 float& v) const {
+    float t = 0;
+    return intersect_segment(origin, direction, 0.0f, std::numeric_limits<float>::infinity(),
+                             triangle, u, v, t);
+  }
+
+  /// Nearest hit along the ray in (t_near, t_far): triangle, barycentrics and distance t.
+  bool intersect_segment(const Vec3f& origin, const Vec3f& direction, float t_near, float t_far,
+                         unsigned& triangle, float& u, float& v, float& t) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRayHit rh{};
+    set_ray(rh.ray, origin, direction, t_far);
+    rh.ray.tnear = t_near;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(scene_, &context, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    triangle = rh.hit.primID;
+    u = rh.hit.u;
+    v = rh.hit.v;
+    t = rh.ray.tfar;
+    return true;
+  }
+
+  bool occluded(const Vec3f& origin, const Vec3f& direction, double max_distance) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRay ray{};
+    set_ray(ray, origin, direction, max_distance);
+    rtcOccluded1(scene_, &context, &ray);
+    return ray.tfar < 0;  // Embree sets tfar = -inf on a hit
+  }
+
+ private:
+  static void set_ray(RTCRay& ray, const Vec3f& o, const Vec3f& d, double tfar) {
+    ray.org_x = o.x();
+    ray.org_y = o.y();
+    ray.org_z = o.z();
+    ray.dir_x = d.x();
+    ray.dir_y = d.y();
+    ray.dir_z = d.z();
+    ray.tnear = 0.0f;
+    ray.tfar = std::isinf(tfar) ? std::numeric_limits<float>::infinity() : float(tfar);
+    ray.mask = ~0u;
+    ray.flags = 0;
+    ray.time = 0.0f;
+  }
+
+  RTCDevice device_ = nullptr;
+  RTCScene scene_ = nullptr;
+};
+
+// ---------------------------------------------------------------------------------------------
+// The BSSRDF per channel, in double.
+
+class ChannelBssrdf {
+ public:
+  ChannelBssrdf(const materials::Medium<double>& medium, DiffusionModel model)
+      : model_(model), dipole_(medium), ddipole_(medium) {
+    if (model == DiffusionModel::kTabulated) {
+      profile_ = materials::cached_tabulated_profile(materials::default_transport_table(),
+                                                     medium.g, medium.eta);
+      tabulated_ = std::make_shared<materials::TabulatedModel<double>>(*profile_, medium);
+    }
+  }
+
+  /// S_d per mm^2 per sr without Fresnel; n_i and w_i are ignored by the radial models (the
+  /// tabulated one's is TabulatedModel::S_d).
+  double operator()(const Vec3d& x_i, const Vec3d& n_i, const Vec3d& w_i, const Vec3d& x_o,
+                    const Vec3d& n_o) const {
+    if (model_ == DiffusionModel::kDipole) return dipole_.S_d((x_o - x_i).norm());
+    if (model_ == DiffusionModel::kTabulated)
+      return tabulated_->S_d((x_o - x_i).norm());
+    return ddipole_.S_d(x_i, n_i, w_i, x_o, n_o);
+  }
+
+ private:
+  DiffusionModel model_;
+  materials::StandardDipole<double> dipole_;
+  materials::DirectionalDipole<double> ddipole_;
+  std::shared_ptr<const materials::TabulatedProfile> profile_;
+  std::shared_ptr<const materials::TabulatedModel<double>> tabulated_;
+};
+
+/// The direction w from x toward a light, the falloff 1 / distance^2 of a point light (1 for a
+/// directional one) and the distance (infinite for a directional light); false at the light.
+inline bool toward_light(const Light& light, const Vec3f& x, Vec3f& w, double& falloff,
+                         double& distance) {
+  falloff = 1;
+  distance = kInf;
+  if (light.type == LightType::kDirectional) {
+    w = light.direction.normalized();
+    return true;
+  }
+  const Vec3f to_light = light.position - x;
+  distance = to_light.norm();
+  if (!(distance > 0)) return false;
+  w = to_light / float(distance);
+  falloff = 1.0 / (distance * distance);
+  return true;
+}
+
+struct PixelHit {
+  Vec3f x_o, n_o;
+  double fresnel_out = 0;  ///< F_t(eta, n_o . w_o)
+  double fresnel_reflect = 0;
+  Vec3f reflected = Vec3f::Zero();
+  Vec3f w_o = Vec3f::Zero();  ///< toward the eye
+  Vec3f g_o = Vec3f::Zero();  ///< geometric normal (shadow-ray offset)
+};
+
+/// One pass of the probe-ray sampler (reference_probes.cpp): for each object pixel i, the
+/// subsurface radiance before the outgoing Fresnel factor, added to accumulated[i].
+/// Every light's specular lobe at a pixel's point, with shadow rays (reference_specular.cpp);
+/// `key`: the random stream for area lights' points.
+Vec3f specular_radiance(const Scene& scene, const RayScene& rays, const PixelHit& hit, float eps,
+                        std::uint64_t key);
+
+class IrradianceCache;
+
+/// `cache`: area lights' irradiance from it (else shadow rays per hit); may be null.
+void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions& options,
+                const RayScene& rays, const IrradianceCache* cache,
+                const std::vector<PixelHit>& hits,
+                const std::vector<std::uint32_t>& object_pixels, int pass, int threads,
+                std::vector<std::array<double, 3>>& accumulated, std::uint64_t& probe_hits,
+                const std::function<void(std::size_t)>& on_progress);
+
+// Surface samples.
+
+struct SurfaceSampler {
+  explicit SurfaceSampler(const Mesh& mesh) : mesh_(mesh) {
+    cdf_.resize(mesh.triangles.size() + 1, 0.0);
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const auto& tri = mesh.triangles[t];
+      const Vec3d a = mesh.positions[tri[0]].cast<double>(),
+                  b = mesh.positions[tri[1]].cast<double>(),
+                  c = mesh.positions[tri[2]].cast<double>();
+      cdf_[t + 1] = cdf_[t] + 0.5 * (b - a).cross(c - a).norm();
+    }
+  }
+  double area() const { return cdf_.back(); }
+
+  /// Sample k of n: stratum k of the area CDF (jittered by xi1), uniform within its triangle.
+  void sample(std::size_t k, std::size_t n, double xi1, double xi2, Vec3f& x, Vec3f& normal,
+              Vec3f& geometric_normal) const {
+    const double target = (double(k) + xi1) / double(n) * area();
+    auto it = std::upper_bound(cdf_.begin() + 1, cdf_.end() - 1, target);
+    std::size_t t = std::size_t(it - cdf_.begin()) - 1;
+    while (t > 0 && !(cdf_[t + 1] > cdf_[t])) --t;
+    const double width = cdf_[t + 1] - cdf_[t];
+    const double s = std::sqrt(width > 0 ? std::clamp((target - cdf_[t]) / width, 0.0, 1.0) : 0.5);
+    const double b1 = s * (1 - xi2), b2 = s * xi2, b0 = 1 - b1 - b2;
+    const auto& tri = mesh_.triangles[t];
+    const Vec3f &p0 = mesh_.positions[tri[0]], &p1 = mesh_.positions[tri[1]],
+                &p2 = mesh_.positions[tri[2]];
+    x = (b0 * p0.cast<double>() + b1 * p1.cast<double>() + b2 * p2.cast<double>()).cast<float>();
+    normal = (float(b0) * mesh_.normals[tri[0]] + float(b1) * mesh_.normals[tri[1]] +
+              float(b2) * mesh_.normals[tri[2]])
+                 .normalized();
+    geometric_normal = (p1 - p0).cross(p2 - p0).normalized();
+  }
+
+ private:
+  const Mesh& mesh_;
+  std::vector<double> cdf_;
+};
+
+}  // namespace lucent::render::detail

@@ -1,0 +1,570 @@
+// The radiance-map pipeline of Dal Corso 2014 on OpenGL 4.5
+// (render/include/lucent/render/radiance_maps.h).
+#include "radiance_maps_impl.h"
+
+namespace lucent::render {
+
+std::string RadianceMapOptions::to_string() const {
+  std::ostringstream s;
+  s << "RadianceMapOptions{max_blur_level=" << max_blur_level
+    << ", shadow_bias_texels=" << shadow_bias_texels << ", shrink_texels=" << shrink_texels
+    << ", new_radii_each_frame=" << new_radii_each_frame
+    << ", convergence_tolerance=" << convergence_tolerance << ", time_stages=" << time_stages
+    << ", environment_reflection=" << environment_reflection << "}";
+  return s.str();
+}
+
+namespace {
+
+// Per-stage means: the light map is rendered once per restart, the final pass once per displayed
+// frame, the other stages once per accumulated frame.
+StageTimes mean_of(StageTimes sum, int frames, int light_map_renders, int frames_rendered) {
+  const double f = std::max(frames, 1);
+  sum.light_map_ms /= std::max(light_map_renders, 1);
+  sum.radiance_map_ms /= f;
+  sum.mip_blur_ms /= f;
+  sum.final_ms /= std::max(frames_rendered, 1);
+  return sum;
+}
+
+}  // namespace
+
+StageTimes RadianceMapStats::mean_wall() const {
+  return mean_of(sum_wall, frames, light_map_renders, frames_rendered);
+}
+
+StageTimes RadianceMapStats::mean_gpu() const {
+  return mean_of(sum_gpu, frames, light_map_renders, frames_rendered);
+}
+
+std::string RadianceMapStats::to_string() const {
+  const StageTimes w = mean_wall(), g = mean_gpu();
+  std::ostringstream s;
+  s.precision(4);
+  s << "RadianceMapStats{" << gl_renderer << "; frames=" << frames
+    << ", convergence_frame=" << convergence_frame << ", setup=" << setup_ms
+    << "ms; per frame (glFinish + wall clock): light map " << w.light_map_ms << "ms, radiance map "
+    << w.radiance_map_ms << "ms, mip blur " << w.mip_blur_ms << "ms, final " << w.final_ms
+    << "ms; GL_TIME_ELAPSED: " << g.light_map_ms << ", " << g.radiance_map_ms << ", "
+    << g.mip_blur_ms << ", " << g.final_ms << "ms; uncovered " << uncovered_fraction
+    << "; sigma*=" << sigma_star_per_mm << "/mm, R=" << disc_radius_mm
+    << "mm, rho=" << used_disc_radius_mm << "mm, N/L=" << samples_per_light << "}";
+  return s.str();
+}
+
+
+RadianceMapRenderer::RadianceMapRenderer() : impl_(std::make_unique<Impl>()) {}
+RadianceMapRenderer::~RadianceMapRenderer() = default;
+
+void RadianceMapRenderer::setup(const Scene& scene, const RenderSettings& settings,
+                                const RadianceMapOptions& options) {
+  const double t0 = now_ms();
+  impl_ = std::make_unique<Impl>();
+  impl_->build(scene, settings, options);
+  glFinish();
+  impl_->stats.setup_ms = now_ms() - t0;
+}
+
+void RadianceMapRenderer::Impl::build(const Scene& s, const RenderSettings& rs,
+                                      const RadianceMapOptions& o) {
+  scene = s;
+  settings = rs;
+  options = o;
+  settings.validate();
+  if (scene.mesh.positions.empty() || scene.mesh.triangles.empty()) {
+    throw Error("radiance maps: the mesh '" + scene.mesh.name + "' is empty");
+  }
+  if (scene.mesh.normals.size() != scene.mesh.positions.size()) {
+    throw Error("radiance maps: the mesh '" + scene.mesh.name + "' has no per-vertex normals");
+  }
+  if (scene.lights.empty()) throw Error("--light: the radiance maps need at least one light");
+  if (int(scene.lights.size()) > kMaxLights) {
+    throw Error("--light: the radiance maps take at most " + std::to_string(kMaxLights) +
+                " lights, got " + std::to_string(scene.lights.size()));
+  }
+  if (options.max_blur_level < -1) throw Error("--max-blur: must be >= 0 (or -1: automatic)");
+  if (options.max_blur_level < 0) {
+    options.max_blur_level = settings.disc_distribution == DiscDistribution::kProfile ? 0 : 2;
+  }
+  K = settings.directions;
+  L = int(scene.lights.size());
+  GLint max_block = 0;
+  glGetIntegerv(GL_MAX_UNIFORM_BLOCK_SIZE, &max_block);
+  if (K * 80 > max_block) {
+    throw Error("--directions: this OpenGL allows at most " + std::to_string(max_block / 80) +
+                " radiance-map directions, got " + std::to_string(K));
+  }
+  if (settings.samples * 16 > max_block) {
+    throw Error("--samples: this OpenGL allows at most " + std::to_string(max_block / 16) +
+                " disc samples, got " + std::to_string(settings.samples));
+  }
+  centre = scene.mesh.centre();
+  radius_mm = scene.mesh.bounding_radius();
+  stats.gl_renderer = std::string(reinterpret_cast<const char*>(glGetString(GL_RENDERER))) + " | " +
+                      reinterpret_cast<const char*>(glGetString(GL_VERSION));
+
+  upload_mesh();
+  build_programs();
+  build_light_maps();
+  build_radiance_maps();
+  build_final();
+  upload_layers();
+  upload_material();  // and the lights with it (the disc depends on both)
+  for (auto& q : queries) q = gl::create_query(GL_TIME_ELAPSED);
+  render_radiance_depth();
+  // One untimed pass of every program, so that drivers that compile shaders at their first draw
+  // (llvmpipe's JIT, most GPU drivers) do it here and not inside the first frame's timings (seed
+  // §6.3 likewise leaves the first frames out of its timings).
+  render_light_map();
+  level = levels - 1;
+  render_blur();
+  level = 0;
+  render_final();
+  gl::check_errors("radiance-map setup");
+}
+
+void RadianceMapRenderer::Impl::upload_mesh() {
+  mesh = gl::upload_mesh(scene.mesh);
+  empty_vao = gl::create_vertex_array();
+}
+
+void RadianceMapRenderer::Impl::build_programs() {
+  programs_have_area_lights = gl::has_area_lights(scene.lights);
+  std::vector<std::string> defines = {
+      "LUCENT_MAX_LIGHTS " + std::to_string(kMaxLights),
+      "LUCENT_MAX_DIRECTIONS " + std::to_string(K),
+      "LUCENT_MAX_DISC_SAMPLES " + std::to_string(settings.samples),
+      settings.model == DiffusionModel::kDipole      ? "LUCENT_MODEL_DIPOLE"
+      : settings.model == DiffusionModel::kTabulated ? "LUCENT_MODEL_TABULATED"
+                                                     : "LUCENT_MODEL_DDIPOLE"};
+  for (const std::string& d : gl::area_light_defines(scene.lights)) defines.push_back(d);
+  light_map_program = gl::Program({{GL_VERTEX_SHADER, "layered_mesh.vert"},
+                                   {GL_GEOMETRY_SHADER, "light_map.geom"},
+                                   {GL_FRAGMENT_SHADER, "light_map.frag"}},
+                                  defines);
+  radiance_program = gl::Program({{GL_VERTEX_SHADER, "layered_mesh.vert"},
+                                  {GL_GEOMETRY_SHADER, "radiance_map.geom"},
+                                  {GL_FRAGMENT_SHADER, "radiance_map.frag"}},
+                                 defines);
+  blur_program = gl::Program({{GL_VERTEX_SHADER, "fullscreen_layers.vert"},
+                              {GL_GEOMETRY_SHADER, "mip_blur.geom"},
+                              {GL_FRAGMENT_SHADER, "mip_blur.frag"}},
+                             defines);
+  final_program =
+      gl::Program({{GL_VERTEX_SHADER, "final.vert"}, {GL_FRAGMENT_SHADER, "final.frag"}}, defines);
+  background_program = gl::Program(
+      {{GL_VERTEX_SHADER, "background.vert"}, {GL_FRAGMENT_SHADER, "background.frag"}}, defines);
+  present_program = gl::Program(
+      {{GL_VERTEX_SHADER, "background.vert"}, {GL_FRAGMENT_SHADER, "present.frag"}}, defines);
+
+  const auto unit = [](const gl::Program& p, const char* name, GLint u) {
+    glProgramUniform1i(p.id(), p.location(name), u);
+  };
+  unit(radiance_program, "u_light_positions", kUnitLightPositions);
+  unit(radiance_program, "u_light_normals", kUnitLightNormals);
+  unit(radiance_program, "u_light_face_normals", kUnitLightFaceNormals);
+  unit(radiance_program, "u_previous", kUnitPrevious);
+  unit(blur_program, "u_source", 0);
+  unit(final_program, "u_radiance", kUnitRadiance);
+  unit(final_program, "u_radiance_depth", kUnitRadianceDepth);
+  unit(final_program, "u_environment", kUnitEnvironment);
+  unit(final_program, "u_light_positions", kUnitLightPositionsFinal);
+  unit(background_program, "u_environment", kUnitEnvironment);
+  unit(present_program, "u_image", 0);
+
+  // One sampler object per way of reading: filters and wrap modes.
+  const auto sampler = [](GLint min_filter, GLint mag_filter, GLint wrap_s) {
+    gl::Sampler s = gl::create_sampler();
+    glSamplerParameteri(s.id(), GL_TEXTURE_MIN_FILTER, min_filter);
+    glSamplerParameteri(s.id(), GL_TEXTURE_MAG_FILTER, mag_filter);
+    glSamplerParameteri(s.id(), GL_TEXTURE_WRAP_S, wrap_s);
+    glSamplerParameteri(s.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return s;
+  };
+  nearest = sampler(GL_NEAREST, GL_NEAREST, GL_CLAMP_TO_EDGE);
+  linear_clamp = sampler(GL_LINEAR, GL_LINEAR, GL_CLAMP_TO_EDGE);
+  // The final pass reads one whole level (u_mip_level is an integer): bilinear within it.
+  mip_nearest = sampler(GL_LINEAR_MIPMAP_NEAREST, GL_LINEAR, GL_CLAMP_TO_EDGE);
+  // Seed Listing 5.9: compare against the stored depth; nearest, as the seed.
+  shadow = sampler(GL_NEAREST, GL_NEAREST, GL_CLAMP_TO_EDGE);
+  glSamplerParameteri(shadow.id(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+  glSamplerParameteri(shadow.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+  // Lat-long: wrap in u, clamp in v (as environment_lookup on the CPU).
+  environment_sampler = sampler(GL_LINEAR, GL_LINEAR, GL_REPEAT);
+}
+
+void RadianceMapRenderer::Impl::build_light_maps() {
+  const int W = settings.light_map_size;
+  light_positions = gl::create_texture(GL_TEXTURE_2D_ARRAY);
+  light_normals = gl::create_texture(GL_TEXTURE_2D_ARRAY);
+  light_face_normals = gl::create_texture(GL_TEXTURE_2D_ARRAY);
+  light_depth = gl::create_texture(GL_TEXTURE_2D_ARRAY);
+  glTextureStorage3D(light_positions.id(), 1, GL_RGBA32F, W, W, L);
+  glTextureStorage3D(light_normals.id(), 1, GL_RGBA32F, W, W, L);
+  glTextureStorage3D(light_face_normals.id(), 1, GL_RGBA16F, W, W, L);
+  glTextureStorage3D(light_depth.id(), 1, GL_DEPTH_COMPONENT32F, W, W, L);
+  light_fbo = gl::create_framebuffer();
+  glNamedFramebufferTexture(light_fbo.id(), GL_COLOR_ATTACHMENT0, light_positions.id(), 0);
+  glNamedFramebufferTexture(light_fbo.id(), GL_COLOR_ATTACHMENT1, light_normals.id(), 0);
+  glNamedFramebufferTexture(light_fbo.id(), GL_COLOR_ATTACHMENT2, light_face_normals.id(), 0);
+  glNamedFramebufferTexture(light_fbo.id(), GL_DEPTH_ATTACHMENT, light_depth.id(), 0);
+  const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+  glNamedFramebufferDrawBuffers(light_fbo.id(), 3, buffers);
+  gl::check_framebuffer(light_fbo.id(), "the light map");
+  light_matrices = gl::create_buffer();
+  glNamedBufferStorage(light_matrices.id(), kMaxLights * sizeof(detail::Mat4f), nullptr,
+                       GL_DYNAMIC_STORAGE_BIT);
+}
+
+void RadianceMapRenderer::Impl::build_radiance_maps() {
+  const int W = settings.radiance_map_size;
+  levels = 1;
+  while (levels <= options.max_blur_level && (W >> levels) >= 1) ++levels;
+  radiance_depth = gl::create_texture(GL_TEXTURE_2D_ARRAY);
+  glTextureStorage3D(radiance_depth.id(), 1, GL_DEPTH_COMPONENT32F, W, W, K);
+  for (int b = 0; b < 2; ++b) {
+    radiance[b] = gl::create_texture(GL_TEXTURE_2D_ARRAY);
+    glTextureStorage3D(radiance[b].id(), levels, GL_RGBA32F, W, W, K);
+    radiance_fbo[b] = gl::create_framebuffer();
+    // Both ping-pong buffers share one depth array (seed §5.3.6): the geometry does not change.
+    glNamedFramebufferTexture(radiance_fbo[b].id(), GL_COLOR_ATTACHMENT0, radiance[b].id(), 0);
+    glNamedFramebufferTexture(radiance_fbo[b].id(), GL_DEPTH_ATTACHMENT, radiance_depth.id(), 0);
+    gl::check_framebuffer(radiance_fbo[b].id(), "the radiance maps");
+    level_views[b].clear();
+    level_fbos[b].clear();
+    for (int l = 0; l + 1 < levels; ++l) {
+      // A view of level l alone to sample while level l + 1 of the same storage is drawn (GL
+      // forbids sampling a texture bound for drawing, whatever the levels; seed §5.4.2).
+      GLuint view = 0;
+      glGenTextures(1, &view);
+      glTextureView(view, GL_TEXTURE_2D_ARRAY, radiance[b].id(), GL_RGBA32F, GLuint(l), 1, 0,
+                    GLuint(K));
+      level_views[b].emplace_back(view);
+      gl::Framebuffer fbo = gl::create_framebuffer();
+      glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT0, radiance[b].id(), l + 1);
+      gl::check_framebuffer(fbo.id(), "a radiance-map mip level");
+      level_fbos[b].push_back(std::move(fbo));
+    }
+  }
+  layer_cameras = gl::create_buffer();
+  glNamedBufferStorage(layer_cameras.id(), GLsizeiptr(K * 80), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  disc_buffer = gl::create_buffer();
+  glNamedBufferStorage(disc_buffer.id(), GLsizeiptr(settings.samples * 16), nullptr,
+                       GL_DYNAMIC_STORAGE_BIT);
+}
+
+void RadianceMapRenderer::Impl::build_final() {
+  final_width = scene.camera.width;
+  final_height = scene.camera.height;
+  if (final_width < 1 || final_height < 1) throw Error("--size: the image has no pixels");
+  final_color = gl::create_texture(GL_TEXTURE_2D);
+  glTextureStorage2D(final_color.id(), 1, GL_RGBA32F, final_width, final_height);
+  glTextureParameteri(final_color.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(final_color.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  final_depth = gl::create_renderbuffer();
+  glNamedRenderbufferStorage(final_depth.id(), GL_DEPTH_COMPONENT32F, final_width, final_height);
+  final_fbo = gl::create_framebuffer();
+  glNamedFramebufferTexture(final_fbo.id(), GL_COLOR_ATTACHMENT0, final_color.id(), 0);
+  glNamedFramebufferRenderbuffer(final_fbo.id(), GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
+                                 final_depth.id());
+  gl::check_framebuffer(final_fbo.id(), "the final image");
+
+  has_environment = false;
+  if (scene.environment) {
+    environment = gl::upload_environment(*scene.environment);
+    has_environment = true;
+  }
+}
+
+void RadianceMapRenderer::Impl::upload_layers() {
+  const std::vector<Vec3f> directions = detail::halton_sphere_directions(K);
+  layer_cams.clear();
+  std::vector<float> block(std::size_t(K) * 20, 0.0f);
+  for (int k = 0; k < K; ++k) {
+    layer_cams.push_back(detail::fitted_orthographic(centre, radius_mm, directions[k]));
+    std::copy_n(layer_cams[k].view_proj.data(), 16, &block[std::size_t(k) * 16]);
+    const Vec3f& d = layer_cams[k].direction;
+    float* v = &block[std::size_t(K) * 16 + std::size_t(k) * 4];
+    v[0] = d.x();
+    v[1] = d.y();
+    v[2] = d.z();
+  }
+  glNamedBufferSubData(layer_cameras.id(), 0, GLsizeiptr(block.size() * sizeof(float)),
+                       block.data());
+}
+
+void RadianceMapRenderer::Impl::upload_lights() {
+  L = int(scene.lights.size());
+  upload_light_cameras(1);
+  gl::upload_area_lights(radiance_program.id(), scene.lights);
+  gl::upload_area_lights(final_program.id(), scene.lights);
+  upload_disc(1, true);
+}
+
+void RadianceMapRenderer::Impl::upload_light_cameras(int t) {
+  light_cams.clear();
+  std::vector<float> matrices(std::size_t(kMaxLights) * 16, 0.0f);
+  std::vector<float> position(std::size_t(kMaxLights) * 4, 0.0f),
+      radiance_(std::size_t(kMaxLights) * 3, 0.0f), texel(std::size_t(kMaxLights) * 2, 0.0f);
+  for (int l = 0; l < L; ++l) {
+    const Light& light = scene.lights[std::size_t(l)];
+    if (light.type == LightType::kArea) {
+      // Frame t's light map is the view from one point of the polygon (gl_area_lights.h); the
+      // radiance pass weights what it sees with the exact form factor (radiance_map.frag).
+      const Vec3f s = gl::area_light_frame_point(light, std::size_t(l), t);
+      light_cams.push_back(detail::fitted_area_perspective(centre, radius_mm, s,
+                                                           area_light_normal(light)));
+      for (int c = 0; c < 3; ++c) position[std::size_t(l) * 4 + std::size_t(c)] = s[c];
+      position[std::size_t(l) * 4 + 3] = float(2 + gl::area_slot(scene.lights, std::size_t(l)));
+    } else if (light.type == LightType::kDirectional) {
+      const Vec3f d = light.direction.normalized();
+      light_cams.push_back(detail::fitted_orthographic(centre, radius_mm, d));
+      position[std::size_t(l) * 4 + 0] = d.x();
+      position[std::size_t(l) * 4 + 1] = d.y();
+      position[std::size_t(l) * 4 + 2] = d.z();
+      position[std::size_t(l) * 4 + 3] = 0;
+    } else {
+      light_cams.push_back(detail::fitted_perspective(centre, radius_mm, light.position));
+      for (int c = 0; c < 3; ++c) position[std::size_t(l) * 4 + std::size_t(c)] = light.position[c];
+      position[std::size_t(l) * 4 + 3] = 1;
+    }
+    for (int c = 0; c < 3; ++c) radiance_[std::size_t(l) * 3 + std::size_t(c)] = light.radiance[c];
+    std::copy_n(light_cams.back().view_proj.data(), 16, &matrices[std::size_t(l) * 16]);
+    texel[std::size_t(l) * 2] = light_cams.back().extent_mm / float(settings.light_map_size);
+    texel[std::size_t(l) * 2 + 1] = light_cams.back().extent_per_mm / float(settings.light_map_size);
+  }
+  glNamedBufferSubData(light_matrices.id(), 0, GLsizeiptr(matrices.size() * sizeof(float)),
+                       matrices.data());
+  const GLuint p = radiance_program.id();
+  glProgramUniform1i(p, radiance_program.location("u_light_count"), L);
+  glProgramUniform4fv(p, radiance_program.location("u_light_position"), kMaxLights,
+                      position.data());
+  glProgramUniform3fv(p, radiance_program.location("u_light_radiance"), kMaxLights,
+                      radiance_.data());
+  glProgramUniform2fv(p, radiance_program.location("u_light_texel_mm"), kMaxLights, texel.data());
+  const GLuint f = final_program.id();
+  glProgramUniform1i(f, final_program.location("u_light_count"), L);
+  glProgramUniform4fv(f, final_program.location("u_light_position"), kMaxLights, position.data());
+  glProgramUniform3fv(f, final_program.location("u_light_radiance"), kMaxLights, radiance_.data());
+  glProgramUniform2fv(f, final_program.location("u_light_texel_mm"), kMaxLights, texel.data());
+}
+
+void RadianceMapRenderer::Impl::upload_disc(int t, bool redraw) {
+  // The disc: radius of the mesh's bounding box diagonal (seed §5.3.4.1: "a radius equal to the
+  // size of the bounding box"), shared round-robin by the lights.
+  // Drawing the M points is the costly part (tens of ms): only when the material, mesh or lights
+  // changed (upload_lights) or when every frame has new radii.
+  if (redraw || options.new_radii_each_frame) {
+    const double box = (scene.mesh.bounds_max() - scene.mesh.bounds_min()).norm();
+    const Eigen::Vector3d shift =
+        options.new_radii_each_frame ? detail::frame_shift(t) : Eigen::Vector3d::Zero();
+    disc_points = settings.disc_distribution == DiscDistribution::kProfile
+                      ? detail::profile_disc_points(settings.disc_points, scene.material,
+                                                    settings.model, box, shift)
+                      : detail::exponential_disc_points(
+                            settings.disc_points, detail::sigma_star(scene.material, settings.q),
+                            box, shift);
+  }
+  disc = detail::select_disc_samples(disc_points, settings.samples, L, settings.disc_selection, t);
+  std::vector<float> packed(std::size_t(settings.samples) * 4, 0.0f);
+  for (std::size_t i = 0; i < disc.samples.size(); ++i) {
+    packed[i * 4 + 0] = disc.samples[i].x_mm;
+    packed[i * 4 + 1] = disc.samples[i].y_mm;
+    packed[i * 4 + 2] = disc.samples[i].weight_mm2;
+  }
+  glNamedBufferSubData(disc_buffer.id(), 0, GLsizeiptr(packed.size() * sizeof(float)),
+                       packed.data());
+  std::vector<GLint> offset(kMaxLights, 0), count(kMaxLights, 0);
+  for (int l = 0; l < L; ++l) {
+    offset[std::size_t(l)] = disc.light_offset[std::size_t(l)];
+    count[std::size_t(l)] = disc.light_count[std::size_t(l)];
+  }
+  const GLuint p = radiance_program.id();
+  glProgramUniform1iv(p, radiance_program.location("u_light_sample_offset"), kMaxLights,
+                      offset.data());
+  glProgramUniform1iv(p, radiance_program.location("u_light_sample_count"), kMaxLights,
+                      count.data());
+  stats.sigma_star_per_mm = disc.sigma_star_per_mm;
+  stats.disc_radius_mm = disc.disc_radius_mm;
+  stats.used_disc_radius_mm = disc.used_radius_mm;
+  stats.samples_per_light = disc.light_count.empty() ? 0 : disc.light_count[0];
+}
+
+void RadianceMapRenderer::Impl::upload_material() {
+  gl::set_bssrdf_uniforms(radiance_program.id(), scene.material);
+  gl::set_fur_coat_uniforms(radiance_program.id(), scene.fur_coat);
+  gl::set_fur_coat_uniforms(final_program.id(), scene.fur_coat);  // the specular lobe's light
+  if (settings.model == DiffusionModel::kTabulated) {
+    gl::set_tabulated(radiance_program.id(), scene.material, kUnitTabulated, tabulated_rows);
+  }
+  glProgramUniform1f(final_program.id(), final_program.location("u_eta"),
+                     float(scene.material.ior));
+  // sigma* depends on the material: the disc is rebuilt with the lights.
+  upload_lights();
+}
+
+
+void RadianceMapRenderer::Impl::render_light_map() {
+  const int W = settings.light_map_size;
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, light_fbo.id());
+  glViewport(0, 0, W, W);
+  const float zero[4] = {0, 0, 0, 0};
+  const float one = 1.0f;
+  glClearNamedFramebufferfv(light_fbo.id(), GL_COLOR, 0, zero);
+  glClearNamedFramebufferfv(light_fbo.id(), GL_COLOR, 1, zero);
+  glClearNamedFramebufferfv(light_fbo.id(), GL_COLOR, 2, zero);
+  glClearNamedFramebufferfv(light_fbo.id(), GL_DEPTH, 0, &one);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  glDisable(GL_BLEND);
+  light_map_program.use();
+  glBindBufferBase(GL_UNIFORM_BUFFER, kLightMatricesBinding, light_matrices.id());
+  mesh.draw_instanced(L);
+}
+
+void RadianceMapRenderer::Impl::render_radiance_depth() {
+  // Depth pre-pass into the shared depth array, once: the radiance pass then tests GL_LEQUAL with
+  // early fragment tests, so only the surface each texel sees runs the expensive gather.
+  const int W = settings.radiance_map_size;
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, radiance_fbo[0].id());
+  glViewport(0, 0, W, W);
+  const float one = 1.0f;
+  glClearNamedFramebufferfv(radiance_fbo[0].id(), GL_DEPTH, 0, &one);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  radiance_program.use();
+  glProgramUniform1i(radiance_program.id(), radiance_program.location("u_depth_only"), 1);
+  glBindBufferBase(GL_UNIFORM_BUFFER, kLayerCamerasBinding, layer_cameras.id());
+  mesh.draw_instanced(K);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glProgramUniform1i(radiance_program.id(), radiance_program.location("u_depth_only"), 0);
+}
+
+void RadianceMapRenderer::Impl::render_radiance() {
+  // Frame t (1-based) writes buffer t % 2 and reads the sum so far from the other (seed §5.3.3).
+  const int t = frame;
+  const int target = t % 2, previous = 1 - target;
+  if (options.new_radii_each_frame || settings.disc_selection == DiscSelection::kStrata) {
+    upload_disc(t, false);
+  }
+  const int W = settings.radiance_map_size;
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, radiance_fbo[target].id());
+  glViewport(0, 0, W, W);
+  const float zero[4] = {0, 0, 0, 0};
+  glClearNamedFramebufferfv(radiance_fbo[target].id(), GL_COLOR, 0, zero);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LEQUAL);
+  glDepthMask(GL_FALSE);
+  radiance_program.use();
+  const GLuint p = radiance_program.id();
+  glProgramUniform1i(p, radiance_program.location("u_has_previous"), t > 1 ? 1 : 0);
+  glProgramUniform1f(p, radiance_program.location("u_rotation_offset"),
+                     float(t - 1) / float(settings.frames));
+  glBindBufferBase(GL_UNIFORM_BUFFER, kLightMatricesBinding, light_matrices.id());
+  glBindBufferBase(GL_UNIFORM_BUFFER, kLayerCamerasBinding, layer_cameras.id());
+  glBindBufferBase(GL_UNIFORM_BUFFER, kDiscSamplesBinding, disc_buffer.id());
+  glBindTextureUnit(kUnitLightPositions, light_positions.id());
+  glBindSampler(kUnitLightPositions, nearest.id());
+  glBindTextureUnit(kUnitLightNormals, light_normals.id());
+  glBindSampler(kUnitLightNormals, nearest.id());
+  glBindTextureUnit(kUnitLightFaceNormals, light_face_normals.id());
+  glBindSampler(kUnitLightFaceNormals, nearest.id());
+  glBindTextureUnit(kUnitPrevious, radiance[previous].id());
+  glBindSampler(kUnitPrevious, nearest.id());
+  if (settings.model == DiffusionModel::kTabulated) {
+    glBindTextureUnit(kUnitTabulated, tabulated_rows.id());
+    glBindSampler(kUnitTabulated, nearest.id());
+  }
+  mesh.draw_instanced(K);
+  glDepthMask(GL_TRUE);
+  current = target;
+}
+
+void RadianceMapRenderer::Impl::render_blur() {
+  glDisable(GL_DEPTH_TEST);
+  blur_program.use();
+  glBindVertexArray(empty_vao.id());
+  const int W = settings.radiance_map_size;
+  for (int l = 0; l < level; ++l) {
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, level_fbos[current][std::size_t(l)].id());
+    glViewport(0, 0, std::max(W >> (l + 1), 1), std::max(W >> (l + 1), 1));
+    glBindTextureUnit(0, level_views[current][std::size_t(l)].id());
+    glBindSampler(0, linear_clamp.id());
+    glDrawArraysInstanced(GL_TRIANGLES, 0, 3, K);
+  }
+}
+
+void RadianceMapRenderer::Impl::render_final() {
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, final_fbo.id());
+  glViewport(0, 0, final_width, final_height);
+  const float one = 1.0f;
+  glClearNamedFramebufferfv(final_fbo.id(), GL_DEPTH, 0, &one);
+  const detail::Mat4f view_proj = detail::camera_view_proj(scene.camera, centre, radius_mm);
+
+  gl::draw_background(background_program, view_proj, has_environment ? environment.id() : 0,
+                      environment_sampler.id(), kUnitEnvironment, scene.backdrop, empty_vao.id());
+
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  final_program.use();
+  const float texel_mm = 2.0f * radius_mm * 1.02f / float(settings.radiance_map_size);
+  const detail::LayerCamera& any_layer = layer_cams.front();
+  glUniformMatrix4fv(final_program.location("u_view_proj"), 1, GL_FALSE, view_proj.data());
+  glUniform1i(final_program.location("u_layer_count"), K);
+  glUniform1f(final_program.location("u_mip_level"), float(level));
+  glUniform1f(final_program.location("u_depth_bias_mm"), options.shadow_bias_texels * texel_mm);
+  glUniform1f(final_program.location("u_texel_mm"), texel_mm);
+  glUniform1f(final_program.location("u_depth_range_mm"), any_layer.far_mm - any_layer.near_mm);
+  glUniform1f(final_program.location("u_shrink_mm"), options.shrink_texels * texel_mm);
+  glUniform3fv(final_program.location("u_eye"), 1, scene.camera.eye.data());
+  glUniform1i(final_program.location("u_has_environment"),
+              has_environment && options.environment_reflection ? 1 : 0);
+  glUniform1f(final_program.location("u_roughness"), scene.roughness);
+  glUniform1i(final_program.location("u_specular"), scene.specular ? 1 : 0);
+  glBindBufferBase(GL_UNIFORM_BUFFER, kLayerCamerasBinding, layer_cameras.id());
+  glBindBufferBase(GL_UNIFORM_BUFFER, kLightMatricesBinding, light_matrices.id());
+  glBindTextureUnit(kUnitLightPositionsFinal, light_positions.id());
+  glBindSampler(kUnitLightPositionsFinal, nearest.id());
+  glBindTextureUnit(kUnitRadiance, radiance[current].id());
+  glBindSampler(kUnitRadiance, mip_nearest.id());
+  glBindTextureUnit(kUnitRadianceDepth, radiance_depth.id());
+  glBindSampler(kUnitRadianceDepth, shadow.id());
+  mesh.draw();
+}
+
+std::vector<float> RadianceMapRenderer::Impl::read_rgba() const {
+  return gl::read_rgba(final_color.id(), final_width, final_height);
+}
+
+void RadianceMapRenderer::Impl::record_convergence() {
+  const std::vector<float> rgba = read_rgba();
+  std::size_t object = 0, uncovered = 0;
+  for (std::size_t i = 0; i < rgba.size(); i += 4) {
+    object += rgba[i + 3] > 0;
+    uncovered += rgba[i + 3] > 0 && rgba[i + 3] < 1;
+  }
+  stats.uncovered_fraction = object > 0 ? double(uncovered) / double(object) : 0.0;
+  if (!last_image.empty()) {
+    double diff = 0, norm = 0;
+    for (std::size_t i = 0; i < rgba.size(); i += 4) {
+      if (!(rgba[i + 3] > 0)) continue;
+      for (int c = 0; c < 3; ++c) {
+        const double d = double(rgba[i + std::size_t(c)]) - last_image[i + std::size_t(c)];
+        diff += d * d;
+        norm += double(rgba[i + std::size_t(c)]) * rgba[i + std::size_t(c)];
+      }
+    }
+    const double change = norm > 0 ? std::sqrt(diff / norm) : 0.0;
+    stats.frame_change.push_back(change);
+    if (stats.convergence_frame == 0 && change < options.convergence_tolerance) {
+      stats.convergence_frame = frame;
+    }
+  }
+  last_image = rgba;
+}
+
+}  // namespace lucent::render

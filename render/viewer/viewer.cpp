@@ -1,0 +1,492 @@
+// `lucent view` (see viewer.h): one GLFW window with an OpenGL 4.5 core context, the radiance-map
+// renderer drawing into it, Dear ImGui's panel on top, and the CPU reference on a worker thread.
+#include "lucent/render/viewer.h"
+
+#include "lucent/render/area_light.h"
+#include "viewer_impl.h"
+
+#include "lucent/core/atomic_file.h"
+
+namespace lucent::render {
+namespace viewer_detail {
+
+Viewer::Viewer(const ViewerOptions& options)
+    : options_(options),
+      scene_(options.scene),
+      rest_mesh_(options.scene.mesh),
+      object_size_mm_(options.object_size_mm),
+      settings_(options.settings),
+      pending_(options.settings),
+      model_from_material_(options.model_follows_material),
+      view_(options.view),
+      technique_(options.technique),
+      material_source_(options.material_source) {
+  script_ = parse_script(options.script);
+  show_ui_ = !options.hide_panel;
+  auto_exposure_ = options.auto_exposure;
+  settings_.validate();
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  window_ = glfwCreateWindow(
+      options.scene.camera.width, options.scene.camera.height,
+      ("lucent view - " + scene_.material.name + " on " + scene_.mesh.name).c_str(), nullptr,
+      nullptr);
+  if (window_ == nullptr) {
+    throw Error("view: no OpenGL 4.5 core window (" + GlfwSession::last_error() + ")");
+  }
+  glfwMakeContextCurrent(window_);
+  glfwSwapInterval(1);
+  glfwSetWindowUserPointer(window_, this);
+  // Installed before ImGui's, which chain to them.
+  glfwSetScrollCallback(window_, [](GLFWwindow* w, double, double dy) {
+    static_cast<Viewer*>(glfwGetWindowUserPointer(w))->scroll_ += float(dy);
+  });
+  glfwSetKeyCallback(window_, [](GLFWwindow* w, int key, int, int action, int) {
+    if (action == GLFW_PRESS)
+      static_cast<Viewer*>(glfwGetWindowUserPointer(w))->keys_.push_back(key);
+  });
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini in the user's folder
+  ImGui::StyleColorsDark();
+  ImGui::GetStyle().ScaleAllSizes(0.8f);
+  ImGui_ImplGlfw_InitForOpenGL(window_, true);
+  ImGui_ImplOpenGL3_Init("#version 450 core");
+
+  glfwGetFramebufferSize(window_, &width_, &height_);
+  scene_.camera = view_.camera(scene_.mesh, std::max(width_, 1), std::max(height_, 1));
+  if (std::filesystem::is_regular_file(material_source_)) watcher_ = FileWatcher(material_source_);
+  std::snprintf(material_path_.data(), material_path_.size(), "%s", material_source_.c_str());
+  if (deform_amplitude_ != options.deform_amplitude) set_deform(options.deform_amplitude);
+  rebuild_maps();
+  reference_ = std::make_unique<ReferenceWorker>();
+  if (technique_ == TechniqueId::kReference) scene_changed();
+  last_time_ = glfwGetTime();
+}
+
+Viewer::~Viewer() {
+  reference_.reset();
+  if (reference_fbo_ != 0) glDeleteFramebuffers(1, &reference_fbo_);
+  if (reference_texture_ != 0) glDeleteTextures(1, &reference_texture_);
+  maps_.reset();
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+  glfwDestroyWindow(window_);
+}
+
+int Viewer::run() {
+  while (!quit_ && !glfwWindowShouldClose(window_)) {
+    // Frames as fast as they come while the maps accumulate or the mesh moves; otherwise wake for
+    // input, a finished reference pass (the worker needs the CPU more than the window does) and,
+    // now and then, to watch the material file.
+    const bool accumulating =
+        (technique_ == TechniqueId::kMaps && maps_ && (deformer_ || !maps_->converged())) ||
+        ((technique_ == TechniqueId::kSh || technique_ == TechniqueId::kHierarchical) &&
+         deformer_) ||
+        (technique_ == TechniqueId::kFur && fur_lobe_);
+    if (accumulating) {
+      glfwPollEvents();
+    } else {
+      glfwWaitEventsTimeout(
+          script_pos_ < script_.size() || technique_ == TechniqueId::kReference ? 0.05 : 0.25);
+    }
+    frame();
+  }
+  std::printf(
+      "view: %ld frames drawn, %d restarts, %d screenshots; technique %s, accumulated %d of %d "
+      "frames\n",
+      frames_drawn_, restarts_, screenshots_, technique_info(technique_).name.c_str(),
+      maps_ ? maps_->accumulated_frames() : 0, settings_.frames);
+  return 0;
+}
+
+void Viewer::frame() {
+  const double now = glfwGetTime();
+  frame_ms_ = 1000 * (now - last_time_);
+  last_time_ = now;
+  int w = 0, h = 0;
+  glfwGetFramebufferSize(window_, &w, &h);
+  if (w > 0 && h > 0 && (w != width_ || h != height_)) {
+    width_ = w;
+    height_ = h;
+    view_changed();
+  }
+  if (now - last_watch_ > 0.5) {
+    last_watch_ = now;
+    if (watcher_.changed()) {
+      std::printf("view: %s changed, reloading\n", watcher_.path().string().c_str());
+      load_material(watcher_.path().string());
+    }
+  }
+  run_script_step();
+  handle_keys();
+  handle_mouse();
+  if (deformer_ && technique_ != TechniqueId::kReference) {
+    deformer_->apply(now, scene_.mesh);
+    apply_geometry();
+    ++restarts_;
+  }
+
+  ImGui_ImplOpenGL3_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  // The panel's text scales with the window: 1 at 720 pixels high, within 0.55..1.6.
+  ImGui::GetIO().FontGlobalScale = std::clamp(float(height_) / 720.0f, 0.55f, 1.6f);
+  ImGui::NewFrame();
+  if (show_ui_) draw_ui();
+  ImGui::Render();
+
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  if (width_ > 0 && height_ > 0) {
+    if (technique_ == TechniqueId::kMaps && maps_) {
+      maps_->render_frame();
+      glBindFramebuffer(GL_FRAMEBUFFER, 0);
+      if (auto_exposure_ && maps_->accumulated_frames() >= 1) {
+        settings_.exposure = pending_.exposure = auto_exposure(maps_->read_image());
+        auto_exposure_ = false;
+      }
+      if (show_difference_) {
+        draw_difference();
+      } else {
+        maps_->present(settings_.exposure, width_, height_);
+      }
+    } else if (technique_ == TechniqueId::kSh) {
+      draw_sh();
+    } else if (technique_ == TechniqueId::kHierarchical) {
+      draw_hierarchical();
+    } else if (technique_ == TechniqueId::kFur) {
+      draw_fur();
+    } else {
+      draw_reference();
+    }
+  }
+  ++frames_drawn_;
+  // Screenshots read the back buffer before the swap and before the panel is drawn: they show
+  // the image alone (the panel's numbers go to stdout).
+  if (!screenshot_path_.empty()) screenshot(std::exchange(screenshot_path_, {}));
+  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+  if (!panel_screenshot_path_.empty()) screenshot(std::exchange(panel_screenshot_path_, {}));
+  glfwSwapBuffers(window_);
+}
+
+void Viewer::run_script_step() {
+  if (wait_frames_ > 0) {
+    --wait_frames_;
+    return;
+  }
+  const double now = glfwGetTime();
+  if (now < sleep_until_) return;
+  if (settling_) {
+    const bool done = technique_ == TechniqueId::kMaps           ? (maps_ && maps_->converged())
+                      : technique_ == TechniqueId::kSh           ? (sh_ && sh_->stats().frames > 0)
+                      : technique_ == TechniqueId::kHierarchical ? hbe_frames_ > 0
+                      : technique_ == TechniqueId::kFur          ? fur_frames_ > 0
+                                                                 : reference_passes_ > 0;
+    if (!done && now < settle_deadline_) return;
+    if (!done) std::fprintf(stderr, "view: settle: still not done after %g s\n", kSettleTimeout);
+    settling_ = false;
+  }
+  if (script_pos_ >= script_.size()) return;
+  const ScriptAction& a = script_[script_pos_++];
+  if (a.verb == "orbit") {
+    view_.drag(parse_float(a.args[0], "orbit DX"), parse_float(a.args[1], "orbit DY"));
+    view_changed();
+  } else if (a.verb == "light") {
+    drag_light(scene_.lights[std::size_t(selected_light_)], parse_float(a.args[0], "light DX"),
+               parse_float(a.args[1], "light DY"));
+    if (maps_) maps_->set_lights(scene_.lights);
+    scene_changed();
+  } else if (a.verb == "zoom") {
+    view_.zoom(parse_float(a.args[0], "zoom STEPS"));
+    view_changed();
+  } else if (a.verb == "set") {
+    set_parameter(a.args[0], a.args[1]);
+  } else if (a.verb == "wait") {
+    wait_frames_ = std::max(0, int(parse_float(a.args[0], "wait FRAMES")) - 1);
+  } else if (a.verb == "key") {
+    keys_.push_back(GLFW_KEY_A + (std::toupper(static_cast<unsigned char>(a.args[0][0])) - 'A'));
+  } else if (a.verb == "sleep") {
+    sleep_until_ = now + parse_float(a.args[0], "sleep SECONDS");
+  } else if (a.verb == "settle") {
+    settling_ = true;
+    settle_deadline_ = now + kSettleTimeout;
+  } else if (a.verb == "restart") {
+    scene_changed();
+  } else if (a.verb == "quit") {
+    quit_ = true;
+  } else if (a.verb == "screenshot") {
+    screenshot_path_ = a.args[0];  // taken in frame(), after drawing
+    screenshot_scripted_ = true;
+  } else if (a.verb == "screenshot-panel") {
+    panel_screenshot_path_ = a.args[0];  // with the panel on it
+    screenshot_scripted_ = true;
+  } else if (a.verb == "panel") {
+    show_ui_ = a.args[0] == "on";
+  } else if (a.verb == "difference") {
+    show_difference_ = a.args[0] == "on";
+  }
+}
+
+void Viewer::handle_keys() {
+  const std::vector<int> keys = std::exchange(keys_, {});
+  if (ImGui::GetIO().WantCaptureKeyboard) return;
+  for (int key : keys) {
+    if (key == GLFW_KEY_ESCAPE) quit_ = true;
+    if (key == GLFW_KEY_H) show_ui_ = !show_ui_;
+    if (key == GLFW_KEY_D) show_difference_ = !show_difference_;
+    if (key == GLFW_KEY_R) scene_changed();
+    if (key == GLFW_KEY_L) fur_lobe_ = !fur_lobe_;  // fur: the seed's rotating lobe light
+    if (key == GLFW_KEY_LEFT_BRACKET) scale_selected_light(1 / 1.25f);  // an area light's size
+    if (key == GLFW_KEY_RIGHT_BRACKET) scale_selected_light(1.25f);
+    if (key == GLFW_KEY_S) {
+      screenshot_path_ = next_screenshot_path();  // taken after drawing
+      screenshot_scripted_ = false;
+    }
+  }
+}
+
+void Viewer::handle_mouse() {
+  const ImGuiIO& io = ImGui::GetIO();
+  double x = 0, y = 0;
+  glfwGetCursorPos(window_, &x, &y);
+  const bool left = glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
+  const bool right = glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS;
+  if (!(left || right)) {
+    dragging_ = false;
+  } else if (!dragging_) {
+    dragging_ = !io.WantCaptureMouse;  // a drag that starts on the panel belongs to the panel
+  } else {
+    const float dx = float(x - last_x_), dy = float(y - last_y_);
+    if (dx != 0 || dy != 0) {
+      if (left) {
+        view_.drag(dx, dy);
+        view_changed();
+      } else {
+        drag_light(scene_.lights[std::size_t(selected_light_)], 0.4f * dx, -0.4f * dy);
+        if (maps_) maps_->set_lights(scene_.lights);
+        scene_changed();
+      }
+    }
+  }
+  last_x_ = x;
+  last_y_ = y;
+  if (scroll_ != 0 && !io.WantCaptureMouse) {
+    view_.zoom(scroll_);
+    view_changed();
+  }
+  scroll_ = 0;
+}
+
+void Viewer::view_changed() {
+  ++scene_version_;  // the cached reference was of the old view
+  scene_.camera = view_.camera(scene_.mesh, std::max(width_, 1), std::max(height_, 1));
+  if (maps_) maps_->set_camera(scene_.camera);  // the maps do not depend on the view
+  if (technique_ == TechniqueId::kReference) scene_changed();
+}
+
+void Viewer::scene_changed() {
+  ++restarts_;
+  ++scene_version_;
+  if (maps_) maps_->restart();
+  if (technique_ == TechniqueId::kReference) {
+    // Half the window's resolution in each direction: four times fewer pixels to integrate.
+    Scene small = scene_;
+    small.camera.width = std::max(1, width_ / 2);
+    small.camera.height = std::max(1, height_ / 2);
+    reference_->start(small, settings_.model, options_.reference);
+    reference_passes_ = 0;
+  } else if (reference_) {
+    reference_->pause();
+  }
+}
+
+void Viewer::rebuild_maps() {
+  try {
+    auto maps = std::make_unique<RadianceMapRenderer>();
+    RadianceMapOptions map_options;
+    map_options.time_stages = true;
+    maps->setup(scene_, settings_, map_options);
+    maps_ = std::move(maps);
+    ++restarts_;
+  } catch (const Error& e) {
+    message_ = e.what();
+    std::fprintf(stderr, "view: %s\n", e.what());
+    pending_ = settings_;  // keep showing what runs
+    if (!maps_) throw;
+  }
+}
+
+void Viewer::set_parameter(const std::string& name, const std::string& value) {
+  if (name == "technique") return set_technique(value);
+  if (name == "disc") {
+    settings_.disc_selection = pending_.disc_selection = parse_disc_selection(value);
+    return rebuild_maps();  // the reference does not use the disc
+  }
+  if (name == "model") {
+    settings_.model = materials::parse_diffusion_model(value, "--script set model", true);
+    pending_ = settings_;
+    model_from_material_ = false;
+    rebuild_maps();
+    return scene_changed();  // the reference uses the model too
+  }
+  const float v = parse_float(value, "set " + name);
+  if (name == "exposure") {
+    settings_.exposure = pending_.exposure = v;
+  } else if (name == "light_scale") {
+    scale_selected_light(v);
+  } else if (name == "size") {
+    set_object_size(v);
+  } else if (name == "deform") {
+    set_deform(v);
+  } else {
+    RenderSettings next = settings_;
+    if (name == "N")
+      next.samples = int(v);
+    else if (name == "M")
+      next.disc_points = int(v);
+    else if (name == "q")
+      next.q = v;
+    else if (name == "K")
+      next.directions = int(v);
+    else if (name == "Ws")
+      next.radiance_map_size = int(v);
+    else if (name == "Wl")
+      next.light_map_size = int(v);
+    else if (name == "T")
+      next.frames = int(v);
+    else
+      throw Error(
+          "--script: set " + name +
+          ": expected N, M, q, K, Ws, Wl, T, exposure, size, deform, light_scale, disc, technique or "
+          "model");
+    next.validate();
+    settings_ = pending_ = next;
+    rebuild_maps();
+  }
+}
+
+void Viewer::load_material(const std::string& source) {
+  try {
+    scene_.material = materials::load_material(source);
+  } catch (const Error& e) {
+    message_ = e.what();  // keep the material that works
+    std::fprintf(stderr, "view: %s\n", e.what());
+    return;
+  }
+  material_source_ = source;
+  watcher_ = std::filesystem::is_regular_file(source) ? FileWatcher(source) : FileWatcher();
+  message_ = "material: " + scene_.material.name;
+  if (model_from_material_) {
+    const DiffusionModel model = materials::preferred_model(scene_.material);
+    if (model != settings_.model) {
+      settings_.model = pending_.model = model;
+      rebuild_maps();  // the model is compiled into the maps' programs
+    }
+  }
+  glfwSetWindowTitle(window_,
+                     ("lucent view - " + scene_.material.name + " on " + scene_.mesh.name).c_str());
+  if (maps_) maps_->set_material(scene_.material);
+  scene_changed();
+}
+
+void Viewer::set_object_size(double mm) {
+  if (!(mm > 0) || !std::isfinite(mm)) {
+    message_ = "object size: must be positive (mm)";
+    return;
+  }
+  // The lighting geometry scales with the object (point lights move out with it and keep the
+  // irradiance they give it): only the material's length scale against the object changes.
+  const float s = float(mm / object_size_mm_);
+  object_size_mm_ = mm;
+  for (Vec3f& p : rest_mesh_.positions) p *= s;
+  for (Light& light : scene_.lights) {
+    if (light.type == LightType::kPoint) {
+      light.position *= s;
+      light.radiance *= s * s;
+    }
+    // An area light scaled about the centre keeps the solid angle it subtends: same radiance.
+    for (Vec3f& p : light.polygon) p *= s;
+    if (light.type == LightType::kArea) light.position = area_light_centroid(light);
+  }
+  if (deformer_) deformer_.emplace(rest_mesh_, deform_amplitude_);
+  scene_.mesh = rest_mesh_;
+  apply_geometry();
+  if (maps_) maps_->set_lights(scene_.lights);
+  view_changed();
+  scene_changed();
+}
+
+void Viewer::scale_selected_light(float scale) {
+  Light& light = scene_.lights[std::size_t(selected_light_)];
+  if (!resize_light(light, scale)) {
+    message_ = "light size: only an area light (rect) can be resized, by a scale > 0";
+    return;
+  }
+  if (maps_) maps_->set_lights(scene_.lights);
+  scene_changed();
+}
+
+void Viewer::set_deform(float amplitude) {
+  deform_amplitude_ = std::clamp(amplitude, 0.0f, 0.2f);
+  if (deform_amplitude_ > 0) {
+    deformer_.emplace(rest_mesh_, deform_amplitude_);
+  } else if (deformer_) {
+    deformer_.reset();
+    scene_.mesh = rest_mesh_;
+    apply_geometry();
+    scene_changed();
+  }
+}
+
+void Viewer::apply_geometry() {
+  ++geometry_version_;  // sh takes it at its next frame
+  if (maps_) maps_->set_geometry(scene_.mesh.positions, scene_.mesh.normals);
+}
+
+std::filesystem::path Viewer::next_screenshot_path() const {
+  for (int i = 1;; ++i) {
+    char name[64];
+    std::snprintf(name, sizeof name, "lucent_view_%03d.png", i);
+    if (!std::filesystem::exists(name)) return name;
+  }
+}
+
+void Viewer::screenshot(const std::filesystem::path& path) {
+  std::vector<std::uint8_t> rgb(std::size_t(width_) * height_ * 3);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadBuffer(GL_BACK);
+  glReadPixels(0, 0, width_, height_, GL_RGB, GL_UNSIGNED_BYTE, rgb.data());
+  imaging::RawImage image(width_, height_, 255);
+  for (int y = 0; y < height_; ++y) {
+    const std::size_t row = std::size_t(height_ - 1 - y) * std::size_t(width_) * 3;
+    for (int x = 0; x < width_; ++x) {
+      for (int c = 0; c < 3; ++c) image.at(x, y, c) = rgb[row + std::size_t(x) * 3 + c];
+    }
+  }
+  try {
+    imaging::write_png(path, image);
+    commit_pending_outputs();  // a screenshot appears when taken, not when the viewer closes
+    ++screenshots_;
+    message_ = "wrote " + path.string();
+    std::printf("view: wrote %s (%dx%d, frame %d of %d)\n", path.string().c_str(), width_, height_,
+                maps_ ? maps_->accumulated_frames() : 0, settings_.frames);
+    std::fflush(stdout);
+  } catch (const Error& e) {
+    // A script asked for it: the run fails with it (a failed screenshot exited 0); a key press
+    // only says so on the panel and stderr.
+    if (std::exchange(screenshot_scripted_, false)) throw;
+    message_ = e.what();
+    std::fprintf(stderr, "view: %s\n", e.what());
+  }
+}
+
+}  // namespace viewer_detail
+
+int run_viewer(const ViewerOptions& options) {
+  viewer_detail::Viewer viewer(options);
+  return viewer.run();
+}
+
+}  // namespace lucent::render

@@ -1,0 +1,283 @@
+// The viewer's internals (render/viewer/viewer.cpp, viewer_panel.cpp): the script, the reference
+// worker thread, the GLFW session and the Viewer class. Private to lucent_viewer.
+#pragma once
+
+// clang-format off
+#include "gl_api.h"  // first: GLFW must not pull in the legacy GL header
+#define GLFW_INCLUDE_NONE
+#include <functional>
+#include <GLFW/glfw3.h>
+// clang-format on
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <imgui_impl_opengl3.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <sstream>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "lucent/core/error.h"
+#include "lucent/imaging/image_io.h"
+#include "lucent/materials/material.h"
+#include "lucent/materials/profile_table.h"
+#include "lucent/render/fur_renderer.h"
+#include "lucent/render/hierarchical_renderer.h"
+#include "lucent/render/radiance_maps.h"
+#include "lucent/render/sh_renderer.h"
+#include "lucent/render/tone_map.h"
+
+#include "lucent/render/image_compare.h"
+#include "lucent/render/technique.h"
+#include "lucent/render/viewer.h"
+#include "viewer_script.h"
+
+namespace lucent::render::viewer_detail {
+
+// ---------------------------------------------------------------------------------------------
+// The CPU reference on a worker thread: one pass after another (new samples each), summed until the
+// scene changes; the main thread shows the running mean.
+
+class ReferenceWorker {
+ public:
+  ReferenceWorker() : thread_([this] { loop(); }) {}
+  ~ReferenceWorker() {
+    {
+      std::lock_guard lock(mutex_);
+      quit_ = true;
+    }
+    wake_.notify_all();
+    thread_.join();
+  }
+
+  /// Starts over on `scene` (what the worker is doing now is thrown away when it finishes).
+  void start(const Scene& scene, DiffusionModel model, const ReferenceOptions& options) {
+    {
+      std::lock_guard lock(mutex_);
+      job_ = Job{scene, model, options, ++generation_};
+      sum_ = ImageRgb();
+      passes_ = 0;
+      error_.clear();
+      fresh_ = false;
+    }
+    wake_.notify_all();
+  }
+  /// Stops after the current pass.
+  void pause() {
+    std::lock_guard lock(mutex_);
+    job_.reset();
+    ++generation_;
+  }
+  /// The mean over the passes so far, when a pass has finished since the last call.
+  bool take(ImageRgb& mean, int& passes, std::string& error) {
+    std::lock_guard lock(mutex_);
+    error = error_;
+    if (!fresh_) return false;
+    fresh_ = false;
+    mean = sum_;
+    for (float& v : mean.data) v /= float(passes_);
+    passes = passes_;
+    return true;
+  }
+
+ private:
+  struct Job {
+    Scene scene;
+    DiffusionModel model;
+    ReferenceOptions options;
+    std::uint64_t generation;
+  };
+
+  void loop() {
+    for (;;) {
+      Job job;
+      int pass = 0;
+      {
+        std::unique_lock lock(mutex_);
+        wake_.wait(lock, [&] { return quit_ || job_.has_value(); });
+        if (quit_) return;
+        job = *job_;
+        pass = passes_;
+      }
+      ReferenceOptions options = job.options;
+      options.passes = 1;
+      options.seed = job.options.seed + std::uint64_t(pass) * 7919;
+      options.progress = nullptr;
+      std::optional<ImageRgb> image;
+      std::string error;
+      try {
+        image = render_reference(job.scene, job.model, options).image;
+      } catch (const std::exception& e) {
+        error = e.what();
+      }
+      std::lock_guard lock(mutex_);
+      if (job.generation != generation_) continue;  // the scene changed meanwhile
+      if (!image) {
+        error_ = error;
+        job_.reset();
+        continue;
+      }
+      if (sum_.data.empty()) sum_ = ImageRgb(image->width, image->height);
+      for (std::size_t i = 0; i < sum_.data.size(); ++i) sum_.data[i] += image->data[i];
+      ++passes_;
+      fresh_ = true;
+      if (passes_ >= kMaxPasses) job_.reset();
+    }
+  }
+
+  static constexpr int kMaxPasses = 1000;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::optional<Job> job_;
+  std::uint64_t generation_ = 0;
+  ImageRgb sum_;
+  int passes_ = 0;
+  bool fresh_ = false;
+  bool quit_ = false;
+  std::string error_;
+  std::thread thread_;  // last: starts after the members it uses exist
+};
+
+// ---------------------------------------------------------------------------------------------
+
+struct GlfwSession {
+  GlfwSession() {
+    glfwSetErrorCallback([](int, const char* what) { last_error() = what; });
+    if (!glfwInit()) {
+      throw Error(
+          "view: no window system (" + last_error() +
+          "); lucent view needs an X display: run it under `xvfb-run -a` for a virtual one");
+    }
+  }
+  ~GlfwSession() { glfwTerminate(); }
+  static std::string& last_error() {
+    static std::string text;
+    return text;
+  }
+};
+
+constexpr std::array<int, 6> kMapSizes = {64, 128, 256, 512, 1024, 2048};
+
+// The window size and mesh version a frame-by-frame renderer (sh, hierarchical) was made for.
+struct FrameTarget {
+  int width = 0, height = 0;
+  std::uint64_t geometry_version = 0;
+};
+
+class Viewer {
+ public:
+  explicit Viewer(const ViewerOptions& options);
+  ~Viewer();
+  int run();
+
+ private:
+  void frame();
+  void handle_mouse();
+  void handle_keys();
+  void run_script_step();
+  void draw_ui();
+  void draw_reference();
+  void draw_hierarchical();
+  void draw_fur();  // Klotzli & Olano's tile: the scene's lights or the rotating lobe (key L)  //
+                    // the same for the hierarchical technique (its solve on the CPU)
+  void draw_sh();        // sync the scene into the sh renderer, one frame, present
+  void draw_technique_frame(const std::function<void()>& frame,
+                            const std::function<ImageRgb()>& image,
+                            const std::function<void()>& present);
+  void apply_geometry(); // scene_.mesh changed: the maps (and sh at its next frame) take it
+
+  void view_changed();
+  void scene_changed();  // lights, material or geometry: restart whatever is accumulating
+  void rebuild_maps();   // new RenderSettings: new textures and programs
+  void set_parameter(const std::string& name, const std::string& value);
+  void load_material(const std::string& source);
+  void set_object_size(double mm);
+  void scale_selected_light(float scale);  ///< area lights: `[` / `]`, set light_scale S
+  void set_deform(float amplitude);
+  void set_technique(const std::string& name);  // a registry name (the script's `set technique`)
+  void set_technique(TechniqueId technique);
+  void screenshot(const std::filesystem::path& path);
+  void blit(const ImageRgb& image, float exposure);  // tone-mapped, stretched to the window
+  void draw_difference();  // the current technique against the cached reference
+  ImageRgb technique_image() const;  // the maps' or sh's last image, window size
+  void draw_material_controls();
+  void apply_material(const materials::Material& material);
+  std::filesystem::path next_screenshot_path() const;
+
+  ViewerOptions options_;
+  GlfwSession glfw_;
+  GLFWwindow* window_ = nullptr;
+  int width_ = 0, height_ = 0;  // framebuffer pixels
+
+  Scene scene_;
+  Mesh rest_mesh_;  // undeformed, at the current object size
+  std::optional<SineDeformer> deformer_;
+  float deform_amplitude_ = 0;
+  double object_size_mm_ = 100;
+  RenderSettings settings_, pending_;
+  bool model_from_material_ = true;
+  OrbitView view_;
+  TechniqueId technique_ = TechniqueId::kMaps;
+  std::unique_ptr<RadianceMapRenderer> maps_;
+  std::unique_ptr<ShRenderer> sh_;  // made when sh is first chosen; remade on a new window size
+  FrameTarget sh_target_;
+  std::unique_ptr<HierarchicalRenderer> hbe_;
+  FrameTarget hbe_target_;
+  long hbe_frames_ = 0;
+  std::unique_ptr<FurRenderer> fur_;
+  FrameTarget fur_target_;
+  long fur_frames_ = 0;
+  bool fur_lobe_ = false;  // the seed's rotating lobe light instead of the scene's lights
+  std::string material_version_seen_;  // the material the hierarchical solver has
+  std::uint64_t geometry_version_ = 0;
+  std::unique_ptr<ReferenceWorker> reference_;
+  FileWatcher watcher_;
+  double last_watch_ = 0;
+  std::string material_source_;
+  std::array<char, 512> material_path_{};
+  int selected_light_ = 0;
+
+  // The reference image on screen.
+  GLuint reference_texture_ = 0, reference_fbo_ = 0;
+  int reference_w_ = 0, reference_h_ = 0, reference_passes_ = 0;
+  std::string reference_error_;
+
+  std::vector<ScriptAction> script_;
+  std::size_t script_pos_ = 0;
+  double sleep_until_ = 0, settle_deadline_ = 0;
+  bool settling_ = false;
+  static constexpr double kSettleTimeout = 300;  // s
+  std::filesystem::path screenshot_path_, panel_screenshot_path_;
+  bool screenshot_scripted_ = false;  // a script's screenshot that fails ends the run with its error
+  int wait_frames_ = 0;
+  bool quit_ = false;
+  bool show_ui_ = true;
+  bool auto_exposure_ = false;
+  // The reference's latest mean, valid for the scene and view of scene_version_ == its version:
+  // what the difference view compares the maps against.
+  ImageRgb cached_reference_;
+  std::uint64_t scene_version_ = 0, reference_version_ = ~std::uint64_t(0);
+  bool show_difference_ = false;
+  std::string difference_text_;
+  long difference_frame_ = -1000;  // frame of the last printed difference
+  std::string message_;            // last error or notice, shown in the panel
+  std::vector<int> keys_;
+  float scroll_ = 0;
+  bool dragging_ = false;
+  double last_x_ = 0, last_y_ = 0;
+  long frames_drawn_ = 0;
+  int restarts_ = 0, screenshots_ = 0;
+  double frame_ms_ = 0, last_time_ = 0;
+};
+
+}  // namespace lucent::render::viewer_detail
