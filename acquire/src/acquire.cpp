@@ -235,32 +235,76 @@ json noise_to_json(const NoiseModel& noise) {
 
 }  // namespace
 
-AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir,
-                           const AcquireOptions& options) {
-  validate(options);
-  const Capture capture = read_capture(capture_json);
-  AtomicOutputDir out(out_dir);  // checks the folder can be made; removed again unless committed
+namespace {
+
+// run_acquire as named stages over one acquisition's state (the former locals of one long function,
+// members under the same names): the sample's brackets merged, the beam located, the calibration
+// (white reference or given power) and the system response, the profile binned and checked, its
+// provenance, and the outputs written together.
+class AcquireRun {
+ public:
+  AcquireRun(const fs::path& capture_json, const fs::path& out_dir, const AcquireOptions& options)
+      : capture_json(capture_json), out_dir(out_dir), options(options),
+        capture((validate(options), read_capture(capture_json))),
+        out(out_dir),  // checks the folder can be made; removed again unless committed
+        white_given(capture.white_reference.has_value()) {}
+
+  AcquireSummary run() {
+    merge_sample();
+    locate_beam();
+    calibrate();
+    bin_profile();
+    record_provenance();
+    write_outputs();
+    return summary;
+  }
+
+ private:
   // Stage weights: rough shares of the time on a large capture (the merges dominate).
-  const auto progress = [&](const char* stage, double done) {
+  void progress(const char* stage, double done) const {
     if (options.progress) options.progress(stage, done);
-  };
-  const bool white_given = capture.white_reference.has_value();
+  }
+  void merge_sample();
+  void locate_beam();
+  void calibrate();
+  void bin_profile();
+  void record_provenance();
+  void write_outputs();
+
+  const fs::path& capture_json;
+  const fs::path& out_dir;
+  const AcquireOptions& options;
+  const Capture capture;
+  AtomicOutputDir out;
+  const bool white_given;
+  std::optional<ResponseCurve> curve;  // recovered once, shared with the white reference
+  HdrResult hdr;
+  int w = 0, h = 0;
+  AcquireSummary summary;
+  std::optional<BeamPoint> detected;
+  std::array<double, 3> scale{kPi, kPi, kPi};  // pi L per unit power (or per second)
+  json white_json = nullptr;
+  SystemResponse response;
+  std::vector<double> edges;  // the radial bins' edges, mm
+  Profile profile;
+};
+
+void AcquireRun::merge_sample() {
   progress("merging the sample's brackets", 0.0);
 
   // Sample: one response for everything (a recovered curve is shared with the white reference).
-  std::optional<ResponseCurve> curve;
   if (capture.response == Response::kCalibrate) {
     curve = calibrate_response(capture.sample, capture.base_dir);
   }
-  const HdrResult hdr =
-      merge_brackets(capture.sample, capture.response, capture.dark, capture.base_dir, curve);
-  const int w = hdr.width(), h = hdr.height();
+  hdr = merge_brackets(capture.sample, capture.response, capture.dark, capture.base_dir, curve);
+  w = hdr.width(), h = hdr.height();
 
-  AcquireSummary summary;
   summary.width = w;
   summary.height = h;
   summary.masked = hdr.counts;
-  std::optional<BeamPoint> detected;
+}
+
+void AcquireRun::locate_beam() {
   if (capture.beam_point_px) {
     const auto& p = *capture.beam_point_px;
     if (!(p[0] >= 0 && p[0] <= w && p[1] >= 0 && p[1] <= h)) {
@@ -275,11 +319,10 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
     summary.beam_point_px = detected->px;
     summary.beam_point_source = "detected";
   }
+}
 
-  // Calibration.
-  std::array<double, 3> scale{kPi, kPi, kPi};
-  json white_json = nullptr;
-  SystemResponse response;
+// The calibration: the white reference's beam power and system response, or a given power.
+void AcquireRun::calibrate() {
   summary.beam_power_source = "none";
   if (capture.white_reference) {
     const WhiteReference& reference = *capture.white_reference;
@@ -315,8 +358,10 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
   if (summary.calibrated) {
     for (int c = 0; c < 3; ++c) scale[c] = kPi / (*summary.beam_power)[c];
   }
+}
 
-  // Geometry and bins.
+// Geometry and bins: the radius, the radial profile (and 2D samples at oblique incidence), checked.
+void AcquireRun::bin_profile() {
   const auto& bp = summary.beam_point_px;
   const double edge_distance_px = std::min({bp[0], bp[1], w - bp[0], h - bp[1]});
   summary.radius_mm =
@@ -335,10 +380,9 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
   binning.log_bins = options.log_bins;
   binning.radius_mm = summary.radius_mm;
   binning.min_pixels_per_bin = options.min_pixels_per_bin;
-  const std::vector<double> edges = radial_bin_edges_mm(binning, capture.pixel_pitch_mm);
+  edges = radial_bin_edges_mm(binning, capture.pixel_pitch_mm);
 
   progress("binning the profile", white_given ? 0.8 : 0.6);
-  Profile profile;
   profile.calibrated = summary.calibrated;
   profile.capture = capture_json.string();
   profile.pixel_pitch_mm = capture.pixel_pitch_mm;
@@ -386,7 +430,9 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
     summary.samples_2d = int(profile.samples_2d->size());
   }
   summary.bins_written = int(profile.radial.size());
+}
 
+void AcquireRun::record_provenance() {
   json provenance = {
       {"tool", "lucent acquire"},
       {"version", kVersion},
@@ -422,7 +468,10 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
   }
   if (!capture.provenance.is_null()) provenance["capture_provenance"] = capture.provenance;
   profile.provenance = provenance;
+}
 
+void AcquireRun::write_outputs() {
+  const auto& bp = summary.beam_point_px;
   // capture.exr: radiance per unit beam power when calibrated (comparable with the simulator's
   // truth), per second of exposure in the capture's units otherwise.
   imaging::ImageRgb radiance = hdr.radiance;
@@ -466,7 +515,13 @@ AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir
   for (const char* name : {"capture.exr", "profile.json", "profile.csv", "acquire.png"}) {
     summary.files.push_back(out_dir / name);
   }
-  return summary;
+}
+
+}  // namespace
+
+AcquireSummary run_acquire(const fs::path& capture_json, const fs::path& out_dir,
+                           const AcquireOptions& options) {
+  return AcquireRun(capture_json, out_dir, options).run();
 }
 
 json summary_to_json(const AcquireSummary& s) {
