@@ -2,6 +2,7 @@
 #include "lucent/render/technique.h"
 
 #include <algorithm>
+#include <cstdio>
 
 #include "lucent/core/error.h"
 #include "lucent/render/fur_renderer.h"
@@ -10,6 +11,13 @@
 namespace lucent::render {
 
 using materials::DiffusionModel;
+
+namespace {
+template <class Renderer>
+std::unique_ptr<Technique> make() {
+  return std::make_unique<Renderer>();
+}
+}  // namespace
 
 bool TechniqueInfo::supports(DiffusionModel model) const {
   return std::find(models.begin(), models.end(), model) != models.end();
@@ -21,11 +29,12 @@ const std::vector<TechniqueInfo>& techniques() {
                                            DiffusionModel::kDipole};
   static const std::vector<TechniqueInfo> table = {
       {TechniqueId::kMaps, "maps", "radiance maps", "radiance maps",
-       "maps (real-time radiance maps, OpenGL)", true, all, "", true, true, true},
+       "maps (real-time radiance maps, OpenGL)", true, all, "", true, true, true,
+       &make<RadianceMapRenderer>},
       {TechniqueId::kSh, "sh", "SH fast translucency", "SH fast",
        "sh (spherical-harmonics fast translucency, OpenGL, Banterle & Chalmers: not physically "
        "based)",
-       false, all, "", true, false, false},
+       false, all, "", true, false, false, &make<ShRenderer>},
       {TechniqueId::kHierarchical,
        "hierarchical",
        "hierarchical boundary elements",
@@ -37,12 +46,13 @@ const std::vector<TechniqueInfo>& techniques() {
        "integrates the standard dipole (Mertens et al.)",
        true,
        true,
-       false},
+       false,
+       &make<HierarchicalRenderer>},
       {TechniqueId::kFur, "fur", "fur shells with SH transfer", "fur",
        "fur (Klotzli & Olano: shells with SH transfer; --mesh tile is the seed's tile, other "
        "meshes get a "
        "coat of shells over the maps' skin: an extension)",
-       true, all, "", true, true, false},
+       true, all, "", true, true, false, &make<FurRenderer>},
       {TechniqueId::kReference, "reference", "CPU reference", "CPU reference",
        "reference (CPU, slow, exact up to sampling noise)", true, all, "", false, true, false},
   };
@@ -71,6 +81,14 @@ std::string technique_names(const std::function<bool(const TechniqueInfo&)>& whi
   return list;
 }
 
+std::unique_ptr<Technique> make_technique(TechniqueId id) {
+  const TechniqueInfo& info = technique_info(id);
+  if (info.make == nullptr) {
+    throw std::logic_error("make_technique: " + info.name + " renders stills only");
+  }
+  return info.make();
+}
+
 TechniqueId parse_technique(std::string_view name, const std::string& option) {
   if (const TechniqueInfo* t = find_technique(name)) return t->id;
   throw Error(option + ": expected " + technique_names() + ", got '" + std::string(name) + "'");
@@ -91,6 +109,17 @@ ImageRgb render_still(TechniqueId id, const Scene& scene, const TechniqueOptions
       return render_radiance_maps(scene, options.settings, options.maps, stats, nullptr);
   }
   throw std::logic_error("render_still: a technique without a renderer");
+}
+
+std::string FrameStats::to_string() const {
+  std::string text = "frames " + std::to_string(frames);
+  for (std::size_t i = 0; i < pass_ms.size(); ++i) {
+    char ms[32];
+    std::snprintf(ms, sizeof ms, "%.2f", pass_ms[i].second);
+    text += (i == 0 ? "; " : ", ") + pass_ms[i].first + " " + ms + " ms";
+  }
+  for (const std::string& note : notes) text += "; " + note;
+  return text;
 }
 
 std::string settings_text(TechniqueId id, const TechniqueOptions& options) {

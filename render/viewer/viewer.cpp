@@ -70,7 +70,7 @@ Viewer::~Viewer() {
   reference_.reset();
   if (reference_fbo_ != 0) glDeleteFramebuffers(1, &reference_fbo_);
   if (reference_texture_ != 0) glDeleteTextures(1, &reference_texture_);
-  maps_.reset();
+  for (LiveTechnique& t : live_) t.technique.reset();
   ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext();
@@ -82,11 +82,10 @@ int Viewer::run() {
     // Frames as fast as they come while the maps accumulate or the mesh moves; otherwise wake for
     // input, a finished reference pass (the worker needs the CPU more than the window does) and,
     // now and then, to watch the material file.
+    const Technique* t = live(technique_);
     const bool accumulating =
-        (technique_ == TechniqueId::kMaps && maps_ && (deformer_ || !maps_->converged())) ||
-        ((technique_ == TechniqueId::kSh || technique_ == TechniqueId::kHierarchical) &&
-         deformer_) ||
-        (technique_ == TechniqueId::kFur && fur_lobe_);
+        technique_ != TechniqueId::kReference && (t == nullptr || !t->converged() || deformer_ ||
+                                                  (technique_ == TechniqueId::kFur && fur_lobe_));
     if (accumulating) {
       glfwPollEvents();
     } else {
@@ -99,7 +98,7 @@ int Viewer::run() {
       "view: %ld frames drawn, %d restarts, %d screenshots; technique %s, accumulated %d of %d "
       "frames\n",
       frames_drawn_, restarts_, screenshots_, technique_info(technique_).name.c_str(),
-      maps_ ? maps_->accumulated_frames() : 0, settings_.frames);
+      maps_frames(), settings_.frames);
   return 0;
 }
 
@@ -140,26 +139,10 @@ void Viewer::frame() {
 
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   if (width_ > 0 && height_ > 0) {
-    if (technique_ == TechniqueId::kMaps && maps_) {
-      maps_->render_frame();
-      glBindFramebuffer(GL_FRAMEBUFFER, 0);
-      if (auto_exposure_ && maps_->accumulated_frames() >= 1) {
-        settings_.exposure = pending_.exposure = auto_exposure(maps_->read_image());
-        auto_exposure_ = false;
-      }
-      if (show_difference_) {
-        draw_difference();
-      } else {
-        maps_->present(settings_.exposure, width_, height_);
-      }
-    } else if (technique_ == TechniqueId::kSh) {
-      draw_sh();
-    } else if (technique_ == TechniqueId::kHierarchical) {
-      draw_hierarchical();
-    } else if (technique_ == TechniqueId::kFur) {
-      draw_fur();
-    } else {
+    if (technique_ == TechniqueId::kReference) {
       draw_reference();
+    } else {
+      draw_technique();
     }
   }
   ++frames_drawn_;
@@ -179,11 +162,9 @@ void Viewer::run_script_step() {
   const double now = glfwGetTime();
   if (now < sleep_until_) return;
   if (settling_) {
-    const bool done = technique_ == TechniqueId::kMaps           ? (maps_ && maps_->converged())
-                      : technique_ == TechniqueId::kSh           ? (sh_ && sh_->stats().frames > 0)
-                      : technique_ == TechniqueId::kHierarchical ? hbe_frames_ > 0
-                      : technique_ == TechniqueId::kFur          ? fur_frames_ > 0
-                                                                 : reference_passes_ > 0;
+    const Technique* t = live(technique_);
+    const bool done = technique_ == TechniqueId::kReference ? reference_passes_ > 0
+                                                            : t != nullptr && t->converged();
     if (!done && now < settle_deadline_) return;
     if (!done) std::fprintf(stderr, "view: settle: still not done after %g s\n", kSettleTimeout);
     settling_ = false;
@@ -196,7 +177,7 @@ void Viewer::run_script_step() {
   } else if (a.verb == "light") {
     drag_light(scene_.lights[std::size_t(selected_light_)], parse_float(a.args[0], "light DX"),
                parse_float(a.args[1], "light DY"));
-    if (maps_) maps_->set_lights(scene_.lights);
+    ++versions_.lights;
     scene_changed();
   } else if (a.verb == "zoom") {
     view_.zoom(parse_float(a.args[0], "zoom STEPS"));
@@ -265,7 +246,7 @@ void Viewer::handle_mouse() {
         view_changed();
       } else {
         drag_light(scene_.lights[std::size_t(selected_light_)], 0.4f * dx, -0.4f * dy);
-        if (maps_) maps_->set_lights(scene_.lights);
+        ++versions_.lights;
         scene_changed();
       }
     }
@@ -282,14 +263,15 @@ void Viewer::handle_mouse() {
 void Viewer::view_changed() {
   ++scene_version_;  // the cached reference was of the old view
   scene_.camera = view_.camera(scene_.mesh, std::max(width_, 1), std::max(height_, 1));
-  if (maps_) maps_->set_camera(scene_.camera);  // the maps do not depend on the view
+  ++versions_.camera;
   if (technique_ == TechniqueId::kReference) scene_changed();
 }
 
 void Viewer::scene_changed() {
   ++restarts_;
   ++scene_version_;
-  if (maps_) maps_->restart();
+  for (LiveTechnique& t : live_)
+    if (t.technique) t.technique->restart();
   if (technique_ == TechniqueId::kReference) {
     // Half the window's resolution in each direction: four times fewer pixels to integrate.
     Scene small = scene_;
@@ -304,17 +286,16 @@ void Viewer::scene_changed() {
 
 void Viewer::rebuild_maps() {
   try {
-    auto maps = std::make_unique<RadianceMapRenderer>();
-    RadianceMapOptions map_options;
-    map_options.time_stages = true;
-    maps->setup(scene_, settings_, map_options);
-    maps_ = std::move(maps);
+    LiveTechnique& slot = live_[std::size_t(TechniqueId::kMaps)];
+    std::unique_ptr<Technique> maps = make_technique(TechniqueId::kMaps);
+    maps->setup(scene_, technique_options());
+    slot = {std::move(maps), versions_, scene_.camera.width, scene_.camera.height};
     ++restarts_;
   } catch (const Error& e) {
     message_ = e.what();
     std::fprintf(stderr, "view: %s\n", e.what());
     pending_ = settings_;  // keep showing what runs
-    if (!maps_) throw;
+    if (!live(TechniqueId::kMaps)) throw;
   }
 }
 
@@ -387,7 +368,7 @@ void Viewer::load_material(const std::string& source) {
   }
   glfwSetWindowTitle(window_,
                      ("lucent view - " + scene_.material.name + " on " + scene_.mesh.name).c_str());
-  if (maps_) maps_->set_material(scene_.material);
+  ++versions_.material;
   scene_changed();
 }
 
@@ -413,7 +394,7 @@ void Viewer::set_object_size(double mm) {
   if (deformer_) deformer_.emplace(rest_mesh_, deform_amplitude_);
   scene_.mesh = rest_mesh_;
   apply_geometry();
-  if (maps_) maps_->set_lights(scene_.lights);
+  ++versions_.lights;
   view_changed();
   scene_changed();
 }
@@ -424,7 +405,7 @@ void Viewer::scale_selected_light(float scale) {
     message_ = "light size: only an area light (rect) can be resized, by a scale > 0";
     return;
   }
-  if (maps_) maps_->set_lights(scene_.lights);
+  ++versions_.lights;
   scene_changed();
 }
 
@@ -441,8 +422,7 @@ void Viewer::set_deform(float amplitude) {
 }
 
 void Viewer::apply_geometry() {
-  ++geometry_version_;  // sh takes it at its next frame
-  if (maps_) maps_->set_geometry(scene_.mesh.positions, scene_.mesh.normals);
+  ++versions_.geometry;  // every technique takes it at its next frame
 }
 
 std::filesystem::path Viewer::next_screenshot_path() const {
@@ -471,7 +451,7 @@ void Viewer::screenshot(const std::filesystem::path& path) {
     ++screenshots_;
     message_ = "wrote " + path.string();
     std::printf("view: wrote %s (%dx%d, frame %d of %d)\n", path.string().c_str(), width_, height_,
-                maps_ ? maps_->accumulated_frames() : 0, settings_.frames);
+                maps_frames(), settings_.frames);
     std::fflush(stdout);
   } catch (const Error& e) {
     // A script asked for it: the run fails with it (a failed screenshot exited 0); a key press

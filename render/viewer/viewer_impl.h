@@ -168,10 +168,18 @@ struct GlfwSession {
 
 constexpr std::array<int, 6> kMapSizes = {64, 128, 256, 512, 1024, 2048};
 
-// The window size and mesh version a frame-by-frame renderer (sh, hierarchical) was made for.
-struct FrameTarget {
-  int width = 0, height = 0;
-  std::uint64_t geometry_version = 0;
+// How many times each part of the scene has changed: a technique takes the parts whose count moved
+// since it last drew (Viewer::sync), so that one left aside catches up when it is chosen again.
+struct SceneVersions {
+  std::uint64_t camera = 0, lights = 0, material = 0, geometry = 0;
+};
+
+// A frame-by-frame technique the viewer has made (the maps at start, the others when first chosen)
+// and the scene it has.
+struct LiveTechnique {
+  std::unique_ptr<Technique> technique;
+  SceneVersions seen;
+  int width = 0, height = 0;  // the camera's size at setup
 };
 
 class Viewer {
@@ -187,14 +195,15 @@ class Viewer {
   void run_script_step();
   void draw_ui();
   void draw_reference();
-  void draw_hierarchical();
-  void draw_fur();  // Klotzli & Olano's tile: the scene's lights or the rotating lobe (key L)  //
-                    // the same for the hierarchical technique (its solve on the CPU)
-  void draw_sh();        // sync the scene into the sh renderer, one frame, present
-  void draw_technique_frame(const std::function<void()>& frame,
-                            const std::function<ImageRgb()>& image,
-                            const std::function<void()>& present);
-  void apply_geometry(); // scene_.mesh changed: the maps (and sh at its next frame) take it
+  // One frame of the current frame-by-frame technique (made and brought up to date first), on
+  // screen or in the difference view; one that fails says why and hands over to the maps.
+  void draw_technique();
+  Technique& current_technique();  // made, set up for the window's size, synced
+  void sync(LiveTechnique& live);  // the scene's parts that changed since it last drew
+  TechniqueOptions technique_options() const;
+  Technique* live(TechniqueId id) const { return live_[std::size_t(id)].technique.get(); }
+  int maps_frames() const;  // the maps' accumulated frames (0 before they exist)
+  void apply_geometry();    // scene_.mesh changed: every technique takes it at its next frame
 
   void view_changed();
   void scene_changed();  // lights, material or geometry: restart whatever is accumulating
@@ -209,7 +218,7 @@ class Viewer {
   void screenshot(const std::filesystem::path& path);
   void blit(const ImageRgb& image, float exposure);  // tone-mapped, stretched to the window
   void draw_difference();  // the current technique against the cached reference
-  ImageRgb technique_image() const;  // the maps' or sh's last image, window size
+  ImageRgb technique_image() const;  // the current technique's last image, window size
   void draw_material_controls();
   void apply_material(const materials::Material& material);
   std::filesystem::path next_screenshot_path() const;
@@ -228,18 +237,10 @@ class Viewer {
   bool model_from_material_ = true;
   OrbitView view_;
   TechniqueId technique_ = TechniqueId::kMaps;
-  std::unique_ptr<RadianceMapRenderer> maps_;
-  std::unique_ptr<ShRenderer> sh_;  // made when sh is first chosen; remade on a new window size
-  FrameTarget sh_target_;
-  std::unique_ptr<HierarchicalRenderer> hbe_;
-  FrameTarget hbe_target_;
-  long hbe_frames_ = 0;
-  std::unique_ptr<FurRenderer> fur_;
-  FrameTarget fur_target_;
-  long fur_frames_ = 0;
+  // By TechniqueId; the reference's slot stays empty (it runs on reference_, a worker thread).
+  std::array<LiveTechnique, 5> live_;
+  SceneVersions versions_;
   bool fur_lobe_ = false;  // the seed's rotating lobe light instead of the scene's lights
-  std::string material_version_seen_;  // the material the hierarchical solver has
-  std::uint64_t geometry_version_ = 0;
   std::unique_ptr<ReferenceWorker> reference_;
   FileWatcher watcher_;
   double last_watch_ = 0;

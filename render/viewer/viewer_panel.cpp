@@ -135,44 +135,20 @@ void Viewer::draw_ui() {
     ImGui::TextUnformatted("(the deformer pauses for the reference)");
   }
   section("progress");
-  if (technique_ == TechniqueId::kMaps && maps_) {
-    const RadianceMapStats& s = maps_->stats();
-    ImGui::Text("frames %d / %d%s", maps_->accumulated_frames(), settings_.frames,
-                maps_->converged() ? "  (converged)" : "");
-    const StageTimes& t = s.last_wall;
-    ImGui::Text("light map   %8.2f ms", t.light_map_ms);
-    ImGui::Text("radiance map%8.2f ms", t.radiance_map_ms);
-    ImGui::Text("mip blur    %8.2f ms", t.mip_blur_ms);
-    ImGui::Text("final       %8.2f ms", t.final_ms);
-    ImGui::Text("window frame %7.1f ms", frame_ms_);
-    if (settings_.disc_distribution == DiscDistribution::kProfile) {
-      ImGui::Text("disc: the profile's own, R %.3g mm", s.disc_radius_mm);
+  if (const Technique* t = live(technique_)) {
+    // Every frame-by-frame technique's statistics in the one form of FrameStats.
+    const TechniqueInfo& info = technique_info(technique_);
+    const FrameStats s = t->frame_stats();
+    if (info.frame_snapshots) {
+      ImGui::Text("frames %d / %d%s", s.frames, settings_.frames,
+                  t->converged() ? "  (converged)" : "");
     } else {
-      ImGui::Text("disc: sigma* %.3g /mm, rho %.3g of R %.3g mm", s.sigma_star_per_mm,
-                  s.used_disc_radius_mm, s.disc_radius_mm);
+      ImGui::Text("frame %d", s.frames);
     }
-    if (s.uncovered_fraction > 0) {
-      ImGui::Text("unseen by every layer: %.1f%% of pixels", 100 * s.uncovered_fraction);
-    }
-  } else if (technique_ == TechniqueId::kHierarchical && hbe_) {
-    const hbe::Stats& s = hbe_->stats();
-    ImGui::Text("%d triangles, %ld links", s.triangles, s.links);
-    ImGui::Text("link        %8.2f ms", s.link_ms);
-    ImGui::Text("irradiance  %8.2f ms", s.irradiance_ms);
-    ImGui::Text("gather+push %8.2f ms", s.pull_ms + s.gather_ms + s.push_ms);
-    ImGui::Text("draw        %8.2f ms", hbe_->draw_ms());
+    for (const auto& [pass, ms] : s.pass_ms) ImGui::Text("%-12s%8.2f ms", pass.c_str(), ms);
     ImGui::Text("window frame %7.1f ms", frame_ms_);
-  } else if (technique_ == TechniqueId::kSh && sh_) {
-    const ShStats& s = sh_->stats();
-    const ShPassTimes& t = s.last_wall;
-    ImGui::Text("frame %d, primary light %d", s.frames, s.primary_light);
-    ImGui::Text("shadow+peel %8.2f ms", t.shadow_ms + t.peel_ms);
-    ImGui::Text("depth blur  %8.2f ms", t.blur_ms);
-    ImGui::Text("cube map    %8.2f ms", t.cube_ms);
-    ImGui::Text("SH project  %8.2f ms", t.project_ms);
-    ImGui::Text("final       %8.2f ms", t.final_ms);
-    ImGui::Text("window frame %7.1f ms", frame_ms_);
-    if (!technique_info(technique_).physically_based)
+    for (const std::string& note : s.notes) ImGui::TextUnformatted(note.c_str());
+    if (!info.physically_based)
       ImGui::TextDisabled("not physically based: D compares it after a best scale");
   } else {
     ImGui::Text("reference passes %d (%d probes per pixel each)", reference_passes_,
@@ -246,11 +222,11 @@ void Viewer::apply_material(const materials::Material& material) {
   const materials::Material previous = scene_.material;
   scene_.material = material;
   try {
-    if (maps_) maps_->set_material(scene_.material);
+    ++versions_.material;
   } catch (const Error& e) {  // e.g. the tabulated model outside its table
     message_ = e.what();
     scene_.material = previous;
-    if (maps_) maps_->set_material(scene_.material);
+    ++versions_.material;
     return;
   }
   message_ = "material: " + scene_.material.name;

@@ -1,5 +1,6 @@
-// The viewer's techniques (see viewer.h): the switch, the sh renderer's frame, the reference's
-// image on screen, and the difference view of the current technique against the cached reference.
+// The viewer's techniques (see viewer.h): the switch, a frame of the current frame-by-frame
+// technique (technique_base.h), the reference's image on screen, and the difference view of the
+// current technique against the cached reference.
 #include "viewer_impl.h"
 
 namespace lucent::render::viewer_detail {
@@ -16,38 +17,69 @@ void Viewer::set_technique(TechniqueId technique) {
   scene_version_ = version;
 }
 
-namespace {
-
-// Makes `renderer` on first use and anew on a new window size (its targets have the camera's
-// size), and sends it the mesh when that changed since it last had it. Returns true when made.
-template <class Renderer, class Options>
-bool keep_current(std::unique_ptr<Renderer>& renderer, FrameTarget& target, const Scene& scene,
-                  const Options& options, std::uint64_t geometry_version) {
-  if (renderer && target.width == scene.camera.width && target.height == scene.camera.height) {
-    if (target.geometry_version != geometry_version) {
-      renderer->set_geometry(scene.mesh.positions, scene.mesh.normals);
-      target.geometry_version = geometry_version;
-    }
-    return false;
-  }
-  renderer.reset();
-  auto made = std::make_unique<Renderer>();
-  made->setup(scene, options);
-  renderer = std::move(made);
-  target = {scene.camera.width, scene.camera.height, geometry_version};
-  return true;
+TechniqueOptions Viewer::technique_options() const {
+  TechniqueOptions o;
+  o.settings = settings_;
+  o.maps.time_stages = true;  // the panel shows the passes' times
+  o.sh = options_.sh;
+  o.hbe = options_.hbe;
+  o.fur = options_.fur;
+  o.reference = options_.reference;
+  return o;
 }
 
-}  // namespace
+int Viewer::maps_frames() const {
+  const Technique* maps = live(TechniqueId::kMaps);
+  return maps != nullptr ? maps->frame_stats().frames : 0;
+}
 
-// A frame of a technique that fails (a GL error, a scene it refuses) says why and hands over to
-// the maps; otherwise its image goes on screen (or the difference view).
-void Viewer::draw_technique_frame(const std::function<void()>& frame,
-                                  const std::function<ImageRgb()>& image,
-                                  const std::function<void()>& present) {
+void Viewer::sync(LiveTechnique& live) {
+  Technique& t = *live.technique;
+  const SceneVersions& now = versions_;
+  if (live.seen.geometry != now.geometry)
+    t.set_geometry(scene_.mesh.positions, scene_.mesh.normals);
+  if (live.seen.camera != now.camera) t.set_camera(scene_.camera);
+  if (live.seen.lights != now.lights) t.set_lights(scene_.lights);
+  if (live.seen.material != now.material) t.set_material(scene_.material);
+  live.seen = now;
+}
+
+// The current technique: made when first chosen, anew on a new window size where its targets
+// cannot change size, and brought up to date with the scene.
+Technique& Viewer::current_technique() {
+  LiveTechnique& slot = live_[std::size_t(technique_)];
+  const Camera& camera = scene_.camera;
+  if (slot.technique && !slot.technique->resizable() &&
+      (slot.width != camera.width || slot.height != camera.height)) {
+    slot.technique.reset();
+  }
+  if (!slot.technique) {
+    std::unique_ptr<Technique> made = make_technique(technique_);
+    made->setup(scene_, technique_options());
+    slot.technique = std::move(made);
+    slot.seen = versions_;
+    slot.width = camera.width;
+    slot.height = camera.height;
+  }
+  sync(slot);
+  return *slot.technique;
+}
+
+void Viewer::draw_technique() {
+  Technique* t = nullptr;
   try {
-    frame();
+    t = &current_technique();
+    if (technique_ == TechniqueId::kFur && fur_lobe_) {
+      // Klotzli & Olano's single low-frequency lobe turning about the vertical (key L).
+      const double time = glfwGetTime();
+      const Eigen::Vector3d world(std::cos(0.8 * time) * 0.7, 0.7, std::sin(0.8 * time) * 0.7);
+      const ShVector<double> lobe = sh_lobe(tile_from_world(world.normalized()), 4);
+      static_cast<FurRenderer&>(*t).set_light_sh({lobe, lobe, lobe});
+      live_[std::size_t(technique_)].seen.lights = ~std::uint64_t(0);  // the scene's at next sync
+    }
+    t->render_frame();
   } catch (const Error& e) {
+    if (technique_ == TechniqueId::kMaps) throw;  // nothing to hand over to
     message_ = e.what();
     std::fprintf(stderr, "view: %s\n", e.what());
     set_technique(TechniqueId::kMaps);  // what runs
@@ -55,85 +87,19 @@ void Viewer::draw_technique_frame(const std::function<void()>& frame,
   }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   if (auto_exposure_) {
-    settings_.exposure = pending_.exposure = auto_exposure(image());
+    settings_.exposure = pending_.exposure = auto_exposure(t->read_image());
     auto_exposure_ = false;
   }
   if (show_difference_) {
     draw_difference();
   } else {
-    present();
+    t->present(settings_.exposure, width_, height_);
   }
 }
 
-// The sh renderer keeps nothing between frames but its GL objects: the scene goes in before every
-// frame (uniform uploads).
-void Viewer::draw_sh() {
-  draw_technique_frame(
-      [&] {
-        keep_current(sh_, sh_target_, scene_, options_.sh, geometry_version_);
-        sh_->set_camera(scene_.camera);
-        sh_->set_lights(scene_.lights);
-        sh_->set_material(scene_.material);
-        sh_->render_frame();
-      },
-      [&] { return sh_->read_image(); },
-      [&] { sh_->present(settings_.exposure, width_, height_); });
-}
-
-// The hierarchical technique: its hierarchy and links are built on first use (and on a new window
-// size); a new material re-links.
-void Viewer::draw_hierarchical() {
-  draw_technique_frame(
-      [&] {
-        if (keep_current(hbe_, hbe_target_, scene_, options_.hbe, geometry_version_)) {
-          material_version_seen_.clear();
-        }
-        hbe_->set_camera(scene_.camera);
-        hbe_->set_lights(scene_.lights);
-        // A new material (library, file or the panel's sliders): compare its coefficients.
-        std::string key = std::to_string(scene_.material.ior);
-        for (int c = 0; c < 3; ++c) {
-          key += " " + std::to_string(scene_.material.sigma_a[std::size_t(c)]) + " " +
-                 std::to_string(scene_.material.sigma_s_reduced[std::size_t(c)]);
-        }
-        if (material_version_seen_ != key) {
-          if (!material_version_seen_.empty()) hbe_->set_material(scene_.material);
-          material_version_seen_ = key;
-        }
-        hbe_->render_frame();
-        ++hbe_frames_;
-      },
-      [&] { return hbe_->read_image(); },
-      [&] { hbe_->present(settings_.exposure, width_, height_); });
-}
-
-// Seed 001's tile: its transfer is built once (and on a new window size); the light each frame:
-// the scene's, or the seed's single low-frequency lobe turning about the vertical (key L).
-void Viewer::draw_fur() {
-  draw_technique_frame(
-      [&] {
-        keep_current(fur_, fur_target_, scene_, options_.fur, geometry_version_);
-        fur_->set_camera(scene_.camera);
-        if (fur_lobe_) {
-          const double t = glfwGetTime();
-          const Eigen::Vector3d world(std::cos(0.8 * t) * 0.7, 0.7, std::sin(0.8 * t) * 0.7);
-          const ShVector<double> lobe = sh_lobe(tile_from_world(world.normalized()), 4);
-          fur_->set_light_sh({lobe, lobe, lobe});
-        } else {
-          fur_->set_lights(scene_.lights);
-        }
-        fur_->render_frame();
-        ++fur_frames_;
-      },
-      [&] { return fur_->read_image(); },
-      [&] { fur_->present(settings_.exposure, width_, height_); });
-}
-
 ImageRgb Viewer::technique_image() const {
-  if (technique_ == TechniqueId::kSh && sh_) return sh_->read_image();
-  if (technique_ == TechniqueId::kHierarchical && hbe_) return hbe_->read_image();
-  if (technique_ == TechniqueId::kFur && fur_) return fur_->read_image();
-  return maps_->read_image();
+  const Technique* t = live(technique_);
+  return t != nullptr ? t->read_image() : live(TechniqueId::kMaps)->read_image();
 }
 
 void Viewer::draw_reference() {
@@ -162,13 +128,8 @@ void Viewer::draw_difference() {
     difference_text_ =
         "no reference for this view: switch to the CPU reference, let it run a "
         "pass, come back";
-    if (technique_ == TechniqueId::kSh) {
-      sh_->present(settings_.exposure, width_, height_);
-    } else if (technique_ == TechniqueId::kHierarchical) {
-      hbe_->present(settings_.exposure, width_, height_);
-    } else {
-      maps_->present(settings_.exposure, width_, height_);
-    }
+    const Technique* t = live(technique_);
+    (t != nullptr ? t : live(TechniqueId::kMaps))->present(settings_.exposure, width_, height_);
     return;
   }
   // The technique's image averaged 2 x 2 down to the reference's half resolution.
@@ -198,9 +159,10 @@ void Viewer::draw_difference() {
     const ImageDifference d = compare_images(small, ref, mask);
     if (info.physically_based) difference_text_ = d.to_string();
     if (frames_drawn_ - difference_frame_ >= 30) {
-      const std::string frame = technique_ == TechniqueId::kMaps
-                                    ? " (frame " + std::to_string(maps_->accumulated_frames()) + ")"
-                                    : "";
+      const std::string frame =
+          info.frame_snapshots
+              ? " (frame " + std::to_string(live(technique_)->frame_stats().frames) + ")"
+              : "";
       std::printf("view: %s%s against the reference (%d passes): %s\n", info.name.c_str(),
                   frame.c_str(), reference_passes_, difference_text_.c_str());
       std::fflush(stdout);

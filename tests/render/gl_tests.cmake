@@ -39,3 +39,6 @@ lucent_add_test(hierarchical_renderer_test
 lucent_add_test(tradeoff_bench_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/tradeoff_bench_test.cpp
   LIBS lucent::render lucent::materials OpenGL::OpenGL)
+lucent_add_test(technique_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/technique_test.cpp
+  LIBS lucent::render lucent::materials OpenGL::OpenGL)

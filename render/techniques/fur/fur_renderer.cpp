@@ -11,6 +11,7 @@
 #include "lucent/core/error.h"
 #include "lucent/render/area_light.h"
 #include "lucent/render/gl_context.h"
+#include "lucent/render/technique.h"
 #include "radiance_maps_sampling.h"
 
 namespace lucent::render {
@@ -150,6 +151,7 @@ struct FurRenderer::Impl {
   gl::Framebuffer fbo;
   gl::Sampler sampler;
   double precompute_ms = 0, draw_ms = 0;
+  int frames = 0;  // since setup
 
   gl::Program present_program;
 
@@ -225,6 +227,34 @@ void FurRenderer::set_lights(const std::vector<Light>& lights) {
   impl_->upload_lights();
 }
 
+void FurRenderer::set_material(const materials::Material& material) {
+  Impl& m = *impl_;
+  m.scene.material = material;
+  const Vec3f albedo = detail::fur_albedo(material);
+  glProgramUniform3fv(m.program.id(), m.program.location("u_albedo"), 1, albedo.data());
+}
+
+void FurRenderer::setup(const Scene& scene, const TechniqueOptions& options) {
+  setup(scene, options.fur);
+}
+
+bool FurRenderer::converged() const {
+  return impl_->frames > 0;
+}
+
+FrameStats FurRenderer::frame_stats() const {
+  FrameStats f;
+  f.frames = impl_->frames;
+  f.pass_ms = {{"precompute", impl_->precompute_ms}, {"draw", impl_->draw_ms}};
+  f.notes.push_back(std::to_string(impl_->options.shells) + " shells");
+  return f;
+}
+
+std::vector<std::uint8_t> FurRenderer::read_mask() const {
+  const Impl& m = *impl_;
+  return gl::mask_from_rgba(gl::read_rgba(m.color.id(), m.width, m.height), m.width, m.height);
+}
+
 void FurRenderer::set_light_sh(const std::array<ShVector<double>, 3>& light) {
   impl_->upload_sh(light);
 }
@@ -235,7 +265,7 @@ void FurRenderer::present(float exposure, int width, int height) const {
                    height);
 }
 
-void FurRenderer::render_frame() {
+bool FurRenderer::render_frame() {
   Impl& m = *impl_;
   const double t0 = now_ms();
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, m.fbo.id());
@@ -271,7 +301,9 @@ void FurRenderer::render_frame() {
   glDepthMask(GL_TRUE);
   glFinish();
   m.draw_ms = now_ms() - t0;
+  ++m.frames;
   gl::check_errors("a fur frame");
+  return true;
 }
 
 ImageRgb FurRenderer::read_image() const {

@@ -1,6 +1,7 @@
 // The hierarchical technique's GL side (hierarchical_renderer.h): the mesh with a third vertex
 // stream for B, the shading pass, read-back and present.
 #include "lucent/render/hierarchical_renderer.h"
+#include "lucent/render/technique.h"
 
 #include <chrono>
 
@@ -42,6 +43,7 @@ struct HierarchicalRenderer::Impl {
   Vec3f centre = Vec3f::Zero();
   float radius = 1;
   double upload_ms = 0, draw_ms = 0;
+  int frames = 0;  // since setup
   std::vector<float> B_floats;
 
   void fit_bounds() {
@@ -156,6 +158,11 @@ void HierarchicalRenderer::set_lights(const std::vector<Light>& lights) {
 
 void HierarchicalRenderer::set_material(const materials::Material& material) {
   Impl& m = *impl_;
+  const materials::Material& had = m.scene.material;
+  if (had.ior == material.ior && had.sigma_a == material.sigma_a &&
+      had.sigma_s_reduced == material.sigma_s_reduced) {
+    return;  // the same coefficients: the links stand
+  }
   m.scene.material = material;
   m.solver->set_material(material);
   glProgramUniform1f(m.program.id(), m.program.location("u_eta"), float(material.ior));
@@ -171,7 +178,29 @@ void HierarchicalRenderer::set_geometry(const std::vector<Vec3f>& positions,
   m.fit_bounds();
 }
 
-void HierarchicalRenderer::render_frame() {
+void HierarchicalRenderer::setup(const Scene& scene, const TechniqueOptions& options) {
+  setup(scene, options.hbe);
+}
+
+bool HierarchicalRenderer::converged() const {
+  return impl_->frames > 0;
+}
+
+FrameStats HierarchicalRenderer::frame_stats() const {
+  const Impl& m = *impl_;
+  const hbe::Stats& s = m.solver->stats();
+  FrameStats f;
+  f.frames = m.frames;
+  f.pass_ms = {{"link", s.link_ms},
+               {"irradiance", s.irradiance_ms},
+               {"gather+push", s.pull_ms + s.gather_ms + s.push_ms},
+               {"draw", m.draw_ms}};
+  f.notes.push_back(std::to_string(s.triangles) + " triangles, " + std::to_string(s.links) +
+                    " links");
+  return f;
+}
+
+bool HierarchicalRenderer::render_frame() {
   Impl& m = *impl_;
   m.solver->solve();
   double t0 = now_ms();
@@ -207,7 +236,9 @@ void HierarchicalRenderer::render_frame() {
   glDisable(GL_DEPTH_TEST);
   glFinish();
   m.draw_ms = now_ms() - t0;
+  ++m.frames;
   gl::check_errors("a hierarchical frame");
+  return true;
 }
 
 ImageRgb HierarchicalRenderer::read_image() const {

@@ -1,8 +1,10 @@
 // The radiance maps' frame-by-frame API (radiance_maps.h): scene changes, frames, read-back,
 // and render_radiance_maps.
+#include "lucent/render/technique.h"
 #include "radiance_maps_impl.h"
 
 #include <algorithm>
+#include <cstdio>
 
 namespace lucent::render {
 
@@ -128,6 +130,35 @@ void RadianceMapRenderer::present(float exposure, int width, int height) const {
 
 const RadianceMapStats& RadianceMapRenderer::stats() const {
   return impl_->stats;
+}
+
+void RadianceMapRenderer::setup(const Scene& scene, const TechniqueOptions& options) {
+  setup(scene, options.settings, options.maps);
+}
+
+FrameStats RadianceMapRenderer::frame_stats() const {
+  const Impl& m = *impl_;
+  const RadianceMapStats& s = m.stats;
+  FrameStats f;
+  f.frames = accumulated_frames();
+  f.pass_ms = {{"light map", s.last_wall.light_map_ms},
+               {"radiance map", s.last_wall.radiance_map_ms},
+               {"mip blur", s.last_wall.mip_blur_ms},
+               {"final", s.last_wall.final_ms}};
+  char disc[160];
+  if (m.settings.disc_distribution == DiscDistribution::kProfile) {
+    std::snprintf(disc, sizeof disc, "disc: the profile's own, R %.3g mm", s.disc_radius_mm);
+  } else {
+    std::snprintf(disc, sizeof disc, "disc: sigma* %.3g /mm, rho %.3g of R %.3g mm",
+                  s.sigma_star_per_mm, s.used_disc_radius_mm, s.disc_radius_mm);
+  }
+  f.notes.push_back(disc);
+  if (s.uncovered_fraction > 0) {
+    std::snprintf(disc, sizeof disc, "unseen by every layer: %.1f%% of pixels",
+                  100 * s.uncovered_fraction);
+    f.notes.push_back(disc);
+  }
+  return f;
 }
 
 ImageRgb render_radiance_maps(const Scene& scene, const RenderSettings& settings,

@@ -2,6 +2,7 @@
 // (render/include/lucent/render/sh_renderer.h).
 #include "lucent/core/error.h"
 #include "lucent/render/gl_context.h"
+#include "lucent/render/technique.h"
 #include "sh_renderer_impl.h"
 
 namespace lucent::render {
@@ -57,7 +58,29 @@ void ShRenderer::set_output(ShOutput output) {
   impl_->output = output;
 }
 
-void ShRenderer::render_frame() {
+void ShRenderer::setup(const Scene& scene, const TechniqueOptions& options) {
+  setup(scene, options.sh);
+}
+
+bool ShRenderer::converged() const {
+  return impl_->stats.frames > 0;
+}
+
+FrameStats ShRenderer::frame_stats() const {
+  const ShStats& s = impl_->stats;
+  const ShPassTimes& t = s.last_wall;
+  FrameStats f;
+  f.frames = s.frames;
+  f.pass_ms = {{"shadow+peel", t.shadow_ms + t.peel_ms},
+               {"depth blur", t.blur_ms},
+               {"cube map", t.cube_ms},
+               {"SH project", t.project_ms},
+               {"final", t.final_ms}};
+  f.notes.push_back("primary light " + std::to_string(s.primary_light));
+  return f;
+}
+
+bool ShRenderer::render_frame() {
   Impl& m = *impl_;
   m.timed(kShadow, [&] { m.shadow_pass(false); });
   m.timed(kPeel, [&] { m.shadow_pass(true); });
@@ -67,6 +90,7 @@ void ShRenderer::render_frame() {
   m.timed(kFinal, [&] { m.final_pass(); });
   ++m.stats.frames;
   gl::check_errors("an sh frame");
+  return true;
 }
 
 ImageRgb ShRenderer::read_image() const {

@@ -16,6 +16,7 @@
 #include "lucent/render/fur.h"
 #include "lucent/render/render_settings.h"
 #include "lucent/render/scene.h"
+#include "lucent/render/technique_base.h"
 
 namespace lucent::render {
 
@@ -40,26 +41,38 @@ Eigen::Vector3d tile_from_world(const Eigen::Vector3d& w);
 /// only near the poles.
 Eigen::Matrix3d fur_vertex_frame(const Vec3f& n);
 
-class FurRenderer {
+class FurRenderer final : public Technique {
  public:
   FurRenderer();
-  ~FurRenderer();
+  ~FurRenderer() override;
   FurRenderer(const FurRenderer&) = delete;
   FurRenderer& operator=(const FurRenderer&) = delete;
 
   /// Builds the tile (CPU, threads) and the GL objects; the scene's mesh must be `tile`.
   void setup(const Scene& scene, const fur::FurOptions& options);
-  void set_camera(const Camera& camera);  ///< same size as at setup
-  void set_lights(const std::vector<Light>& lights);
+  /// The same with options.fur.
+  void setup(const Scene& scene, const TechniqueOptions& options) override;
+  TechniqueId id() const override { return TechniqueId::kFur; }
+  void set_camera(const Camera& camera) override;  ///< same size as at setup
+  void set_lights(const std::vector<Light>& lights) override;
   /// The light as SH coefficients per channel in the tile's frame (the viewer's rotating lobe).
   void set_light_sh(const std::array<ShVector<double>, 3>& light);
   /// The tile has no mesh to deform: ignored (the viewer's deformer moves other techniques).
-  void set_geometry(const std::vector<Vec3f>&, const std::vector<Vec3f>&) {}
-  void present(float exposure, int width, int height) const;
-  void render_frame();
-  ImageRgb read_image() const;
+  void set_geometry(const std::vector<Vec3f>&, const std::vector<Vec3f>&) override {}
+  /// The hairs' and the skin's albedo (the material's reduced albedo per channel).
+  void set_material(const materials::Material& material) override;
+  /// 1 where the shells or the skin cover a pixel (alpha > 0).
+  std::vector<std::uint8_t> read_mask() const override;
+  void present(float exposure, int width, int height) const override;
+  bool render_frame() override;  ///< always true
+  ImageRgb read_image() const override;
   double precompute_ms() const;  ///< the tile's hairs, cross-sections and transfer
   double draw_ms() const;        ///< the last frame (glFinish + wall clock)
+
+  /// The last frame's draw and the tile's precomputation.
+  FrameStats frame_stats() const override;
+  /// Every frame is the whole image: converged once one is drawn.
+  bool converged() const override;
 
  private:
   struct Impl;

@@ -11,36 +11,48 @@
 #include "lucent/render/hierarchical.h"
 #include "lucent/render/render_settings.h"
 #include "lucent/render/scene.h"
+#include "lucent/render/technique_base.h"
 
 namespace lucent::render {
 
 /// Frame-by-frame renderer; needs a current OpenGL 4.5 core context for every call.
-class HierarchicalRenderer {
+class HierarchicalRenderer final : public Technique {
  public:
   HierarchicalRenderer();
-  ~HierarchicalRenderer();
+  ~HierarchicalRenderer() override;
   HierarchicalRenderer(const HierarchicalRenderer&) = delete;
   HierarchicalRenderer& operator=(const HierarchicalRenderer&) = delete;
 
   /// Builds the hierarchy, uploads the mesh, compiles the programs. Throws lucent::Error on bad
   /// options, an empty mesh, no light or more than 16 lights.
   void setup(const Scene& scene, const hbe::Options& options = {});
-  void set_camera(const Camera& camera);  ///< same size as at setup
-  void set_lights(const std::vector<Light>& lights);
-  void set_material(const materials::Material& material);
-  void set_geometry(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals);
+  /// The same with options.hbe.
+  void setup(const Scene& scene, const TechniqueOptions& options) override;
+  TechniqueId id() const override { return TechniqueId::kHierarchical; }
+  void set_camera(const Camera& camera) override;  ///< same size as at setup
+  void set_lights(const std::vector<Light>& lights) override;
+  /// A material of other coefficients re-links (the links' cut-offs depend on them); the same
+  /// coefficients again change nothing.
+  void set_material(const materials::Material& material) override;
+  void set_geometry(const std::vector<Vec3f>& positions,
+                    const std::vector<Vec3f>& normals) override;
 
   /// One frame: the solve (hbe::Solver::solve), the upload, the draw.
-  void render_frame();
+  bool render_frame() override;  ///< always true
 
-  ImageRgb read_image() const;                ///< linear RGB, row 0 at the top
-  std::vector<std::uint8_t> read_mask() const;  ///< 1 where a pixel sees the object
-  void present(float exposure, int width, int height) const;
+  ImageRgb read_image() const override;                  ///< linear RGB, row 0 at the top
+  std::vector<std::uint8_t> read_mask() const override;  ///< 1 where a pixel sees the object
+  void present(float exposure, int width, int height) const override;
 
   const hbe::Stats& stats() const;  ///< the solve's, last frame
   double upload_ms() const;         ///< last frame's B upload
   double draw_ms() const;           ///< last frame's draw (glFinish + wall clock)
   const hbe::Solver& solver() const;
+
+  /// The last frame's passes (the solve's stages, the upload, the draw) and its links.
+  FrameStats frame_stats() const override;
+  /// Every frame is the whole image: converged once one is drawn.
+  bool converged() const override;
 
  private:
   struct Impl;

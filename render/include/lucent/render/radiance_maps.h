@@ -25,6 +25,7 @@
 
 #include "lucent/render/render_settings.h"
 #include "lucent/render/scene.h"
+#include "lucent/render/technique_base.h"
 
 namespace lucent::render {
 
@@ -93,10 +94,10 @@ struct RadianceMapStats {
 /// Frame-by-frame renderer for `lucent view` and tests. Every call needs the same current
 /// OpenGL 4.5 core context (GlContext::create_headless, or a window's); it throws lucent::Error on
 /// anything the context cannot do and on settings it cannot use.
-class RadianceMapRenderer {
+class RadianceMapRenderer final : public Technique {
  public:
   RadianceMapRenderer();
-  ~RadianceMapRenderer();
+  ~RadianceMapRenderer() override;
   RadianceMapRenderer(const RadianceMapRenderer&) = delete;
   RadianceMapRenderer& operator=(const RadianceMapRenderer&) = delete;
 
@@ -104,33 +105,41 @@ class RadianceMapRenderer {
   /// accumulating.
   void setup(const Scene& scene, const RenderSettings& settings,
              const RadianceMapOptions& options = {});
+  /// The same with options.settings and options.maps.
+  void setup(const Scene& scene, const TechniqueOptions& options) override;
+  TechniqueId id() const override { return TechniqueId::kMaps; }
 
-  /// The viewer's camera; the radiance maps do not depend on it, so accumulation goes on.
-  void set_camera(const Camera& camera);
+  /// The viewer's camera, of any size; the radiance maps do not depend on it, so accumulation
+  /// goes on.
+  void set_camera(const Camera& camera) override;
+  bool resizable() const override { return true; }
   /// New lights (at most 16), or a new material: accumulation restarts.
-  void set_lights(const std::vector<Light>& lights);
-  void set_material(const materials::Material& material);
+  void set_lights(const std::vector<Light>& lights) override;
+  void set_material(const materials::Material& material) override;
   /// A deforming mesh: new positions (mm) and unit normals for the same vertices and triangles.
   /// The layer and light cameras are refitted to the new bounds; accumulation restarts.
-  void set_geometry(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals);
+  void set_geometry(const std::vector<Vec3f>& positions,
+                    const std::vector<Vec3f>& normals) override;
   /// Discards the accumulated frames (call after any change the renderer cannot see).
-  void restart();
+  void restart() override;
 
   /// One frame: light map (after a restart), radiance maps and blur while fewer than T frames are
   /// accumulated, then the final pass. Returns true if it accumulated a frame.
-  bool render_frame();
+  bool render_frame() override;
   int accumulated_frames() const;
-  bool converged() const;  ///< T frames accumulated: further frames change nothing
+  bool converged() const override;  ///< T frames accumulated: further frames change nothing
 
   /// The last final pass: linear RGB radiance, camera.width x camera.height, row 0 at the top.
-  ImageRgb read_image() const;
+  ImageRgb read_image() const override;
   /// width * height: 1 where a pixel sees the object, 0 elsewhere (as ReferenceImage::mask).
-  std::vector<std::uint8_t> read_mask() const;
+  std::vector<std::uint8_t> read_mask() const override;
   /// Draws the last final image tone-mapped (exposure, Reinhard, sRGB) into the currently bound
   /// draw framebuffer over width x height pixels (the window of `lucent view`).
-  void present(float exposure, int width, int height) const;
+  void present(float exposure, int width, int height) const override;
 
   const RadianceMapStats& stats() const;
+  /// The last frame's passes (wall clock) and the disc it used.
+  FrameStats frame_stats() const override;
 
  private:
   struct Impl;

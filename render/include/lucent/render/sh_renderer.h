@@ -25,6 +25,7 @@
 
 #include "lucent/render/render_settings.h"
 #include "lucent/render/scene.h"
+#include "lucent/render/technique_base.h"
 
 namespace lucent::render {
 
@@ -88,38 +89,47 @@ struct ShStats {
 enum class ShOutput { kImage, kThickness, kPosition };
 
 /// Frame-by-frame renderer; needs a current OpenGL 4.5 core context for every call.
-class ShRenderer {
+class ShRenderer final : public Technique {
  public:
   ShRenderer();
-  ~ShRenderer();
+  ~ShRenderer() override;
   ShRenderer(const ShRenderer&) = delete;
   ShRenderer& operator=(const ShRenderer&) = delete;
 
   /// Uploads the mesh, builds programs and textures. Throws lucent::Error on bad options, an
   /// empty mesh, no light or more than 16 lights.
   void setup(const Scene& scene, const ShOptions& options = {});
-  void set_camera(const Camera& camera);
-  void set_lights(const std::vector<Light>& lights);
-  void set_material(const materials::Material& material);
+  /// The same with options.sh.
+  void setup(const Scene& scene, const TechniqueOptions& options) override;
+  TechniqueId id() const override { return TechniqueId::kSh; }
+  void set_camera(const Camera& camera) override;
+  void set_lights(const std::vector<Light>& lights) override;
+  void set_material(const materials::Material& material) override;
   /// A deforming mesh: new positions (mm) and unit normals for the same vertices and triangles.
-  void set_geometry(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals);
+  void set_geometry(const std::vector<Vec3f>& positions,
+                    const std::vector<Vec3f>& normals) override;
   void set_output(ShOutput output);
 
   /// One frame: every pass (nothing is kept between frames but the GL objects).
-  void render_frame();
+  bool render_frame() override;  ///< always true
 
   /// The last final pass: linear RGB, camera.width x camera.height, row 0 at the top.
-  ImageRgb read_image() const;
+  ImageRgb read_image() const override;
   /// 1 where a pixel sees the object.
-  std::vector<std::uint8_t> read_mask() const;
+  std::vector<std::uint8_t> read_mask() const override;
   /// The last projection, channel c's coefficient k at [c][k] (read back from the GPU for tests).
   std::array<std::array<float, 9>, 3> read_coefficients() const;
   /// The last cube map: 6 faces of cube_map_size^2 RGBA texels, face-major, rows from t = 0.
   std::vector<float> read_cube_map() const;
   /// The tone-mapped last image into the bound draw framebuffer (the viewer).
-  void present(float exposure, int width, int height) const;
+  void present(float exposure, int width, int height) const override;
 
   const ShStats& stats() const;
+
+  /// The last frame's passes (wall clock) and its primary light.
+  FrameStats frame_stats() const override;
+  /// Every frame is the whole image: converged once one is drawn.
+  bool converged() const override;
 
  private:
   struct Impl;

@@ -1,11 +1,13 @@
-// The techniques lucent renders with, in one registry: each one's name (the CLI's --technique value,
-// and the prefix of its files and flags), what it is (physically based or right only up to a scale,
-// the diffusion models it integrates, whether it needs OpenGL, whether it takes a fur coat or
-// converges frame by frame) and the one place where a technique is chosen by its name. Adding a
-// technique is its sources plus one line in technique.cpp's table and one case in render_still.
+// The techniques lucent renders with, in one registry: each one's name (the CLI's --technique
+// value, and the prefix of its files and flags), what it is (physically based or right only up to a
+// scale, the diffusion models it integrates, whether it needs OpenGL, whether it takes a fur coat
+// or converges frame by frame), the one place where a technique is chosen by its name, and the
+// factory of the frame-by-frame ones (technique_base.h). Adding a technique is its folder plus one
+// line in technique.cpp's table and one case in render_still.
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -18,10 +20,9 @@
 #include "lucent/render/render_settings.h"
 #include "lucent/render/scene.h"
 #include "lucent/render/sh_renderer.h"
+#include "lucent/render/technique_base.h"
 
 namespace lucent::render {
-
-enum class TechniqueId { kMaps, kSh, kHierarchical, kFur, kReference };
 
 struct TechniqueInfo {
   TechniqueId id;
@@ -37,6 +38,9 @@ struct TechniqueInfo {
   bool gpu = true;               ///< needs an OpenGL 4.5 context
   bool fur_coat = true;          ///< renders a fur coat over the skin (--fur-coat on)
   bool frame_snapshots = false;  ///< converges frame by frame and writes snapshots (--snapshots)
+  /// Makes the technique's frame-by-frame renderer (technique_base.h); null for the CPU reference,
+  /// which renders stills only.
+  std::unique_ptr<Technique> (*make)() = nullptr;
 
   bool supports(materials::DiffusionModel model) const;
 };
@@ -52,6 +56,10 @@ TechniqueId parse_technique(std::string_view name, const std::string& option = "
 /// "maps, sh, hierarchical, fur or reference": the names of the techniques `which` accepts (all when
 /// it is empty).
 std::string technique_names(const std::function<bool(const TechniqueInfo&)>& which = {});
+
+/// A new, not yet set up, frame-by-frame renderer of technique `id`; std::logic_error for one
+/// without (the reference).
+std::unique_ptr<Technique> make_technique(TechniqueId id);
 
 /// Every technique's options, as `lucent render` fills them; each technique reads its own (and the
 /// maps' settings carry the model and the exposure every technique uses).
