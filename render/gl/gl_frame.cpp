@@ -130,4 +130,75 @@ std::vector<std::uint8_t> mask_from_rgba(const std::vector<float>& rgba, int wid
   return mask;
 }
 
+namespace {
+Sampler bilinear_sampler(GLint wrap_s) {
+  Sampler s = create_sampler();
+  glSamplerParameteri(s.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glSamplerParameteri(s.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glSamplerParameteri(s.id(), GL_TEXTURE_WRAP_S, wrap_s);
+  glSamplerParameteri(s.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  return s;
+}
+}  // namespace
+
+void FinalTarget::build(const Scene& scene, int width, int height, GLuint environment_unit,
+                        bool with_environment) {
+  background_ =
+      Program({{GL_VERTEX_SHADER, "background.vert"}, {GL_FRAGMENT_SHADER, "background.frag"}});
+  present_ = Program({{GL_VERTEX_SHADER, "background.vert"}, {GL_FRAGMENT_SHADER, "present.frag"}});
+  environment_unit_ = environment_unit;
+  glProgramUniform1i(background_.id(), background_.location("u_environment"),
+                     GLint(environment_unit));
+  glProgramUniform1i(present_.id(), present_.location("u_image"), 0);
+  linear_ = bilinear_sampler(GL_CLAMP_TO_EDGE);
+  environment_sampler_ = bilinear_sampler(GL_REPEAT);
+  empty_vao_ = create_vertex_array();
+  environment_ = Texture();
+  if (with_environment && scene.environment) environment_ = upload_environment(*scene.environment);
+  resize(width, height);
+}
+
+void FinalTarget::resize(int width, int height) {
+  if (width < 1 || height < 1) throw Error("--size: the image has no pixels");
+  width_ = width;
+  height_ = height;
+  color_ = create_texture(GL_TEXTURE_2D);
+  glTextureStorage2D(color_.id(), 1, GL_RGBA32F, width, height);
+  depth_ = create_renderbuffer();
+  glNamedRenderbufferStorage(depth_.id(), GL_DEPTH_COMPONENT32F, width, height);
+  fbo_ = create_framebuffer();
+  glNamedFramebufferTexture(fbo_.id(), GL_COLOR_ATTACHMENT0, color_.id(), 0);
+  glNamedFramebufferRenderbuffer(fbo_.id(), GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_.id());
+  check_framebuffer(fbo_.id(), "the final image");
+}
+
+void FinalTarget::bind() const {
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo_.id());
+  glViewport(0, 0, width_, height_);
+  const float one = 1.0f;
+  glClearNamedFramebufferfv(fbo_.id(), GL_DEPTH, 0, &one);
+}
+
+void FinalTarget::begin_frame(const Eigen::Matrix4f& view_proj, const Vec3f& backdrop) const {
+  bind();
+  draw_background(background_, view_proj, environment_.id(), environment_sampler_.id(),
+                  environment_unit_, backdrop, empty_vao_.id());
+}
+
+void FinalTarget::present(float exposure, int width, int height) const {
+  draw_present(present_, color_.id(), linear_.id(), empty_vao_.id(), exposure, width, height);
+}
+
+std::vector<float> FinalTarget::read_rgba() const {
+  return gl::read_rgba(color_.id(), width_, height_);
+}
+
+ImageRgb FinalTarget::read_image() const {
+  return image_from_rgba(read_rgba(), width_, height_);
+}
+
+std::vector<std::uint8_t> FinalTarget::read_mask() const {
+  return mask_from_rgba(read_rgba(), width_, height_);
+}
+
 }  // namespace lucent::render::gl

@@ -87,14 +87,8 @@ ImageRgb render_fur_mesh(const Scene& scene, const fur::FurOptions& options,
   const gl::Program program({{GL_VERTEX_SHADER, "fur_mesh.vert"}, {GL_FRAGMENT_SHADER, "fur_mesh.frag"}});
   const gl::Program blit({{GL_VERTEX_SHADER, "background.vert"}, {GL_FRAGMENT_SHADER, "image_blit.frag"}});
   const gl::VertexArray vao = gl::create_vertex_array();
-  const gl::Texture color = gl::create_texture(GL_TEXTURE_2D);
-  glTextureStorage2D(color.id(), 1, GL_RGBA32F, W, H);
-  const gl::Renderbuffer depth = gl::create_renderbuffer();
-  glNamedRenderbufferStorage(depth.id(), GL_DEPTH_COMPONENT32F, W, H);
-  const gl::Framebuffer fbo = gl::create_framebuffer();
-  glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT0, color.id(), 0);
-  glNamedFramebufferRenderbuffer(fbo.id(), GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth.id());
-  gl::check_framebuffer(fbo.id(), "the fur image");
+  gl::FinalTarget target;  // bare: the skin image is its background
+  target.resize(W, H);
 
   const float spacing_mm = float(o.height_mm) / float(o.shells);
   const detail::Mat4f view_proj =
@@ -110,10 +104,7 @@ ImageRgb render_fur_mesh(const Scene& scene, const fur::FurOptions& options,
   double draw_ms = 0;
   for (int frame = 0; frame < 2; ++frame) {  // the first compiles shaders on llvmpipe
     const double t_draw = now_ms();
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo.id());
-    glViewport(0, 0, W, H);
-    const float one = 1.0f;
-    glClearNamedFramebufferfv(fbo.id(), GL_DEPTH, 0, &one);
+    target.bind();
     glBindVertexArray(vao.id());
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
@@ -151,7 +142,7 @@ ImageRgb render_fur_mesh(const Scene& scene, const fur::FurOptions& options,
     draw_ms = now_ms() - t_draw;
   }
   gl::check_errors("fur over a mesh");
-  ImageRgb image = gl::image_from_rgba(gl::read_rgba(color.id(), W, H), W, H);
+  ImageRgb image = target.read_image();
   if (stats != nullptr) {
     stats->technique = "fur";
     stats->width = W;

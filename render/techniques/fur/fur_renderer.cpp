@@ -145,15 +145,13 @@ struct FurRenderer::Impl {
   float half_mm = 50, spacing_mm = 1, radius = 1;
   Vec3f centre = Vec3f::Zero();
   gl::VertexArray vao;
-  gl::Program program, background_program;
-  gl::Texture transfer, color;
-  gl::Renderbuffer depth;
-  gl::Framebuffer fbo;
+  gl::Program program;
+  gl::Texture transfer;
   gl::Sampler sampler;
+  // The image, its background and present pass (the tile is shown without an environment).
+  gl::FinalTarget final;
   double precompute_ms = 0, draw_ms = 0;
   int frames = 0;  // since setup
-
-  gl::Program present_program;
 
   void upload_lights() { upload_sh(fur_light_sh(scene.lights, Vec3f(0, 0, 0))); }
   void upload_sh(const std::array<ShVector<double>, 3>& c) {
@@ -196,19 +194,8 @@ void FurRenderer::setup(const Scene& scene, const fur::FurOptions& options) {
   m.sampler = detail::fur_sampler();
   m.vao = gl::create_vertex_array();
   m.program = gl::Program({{GL_VERTEX_SHADER, "fur.vert"}, {GL_FRAGMENT_SHADER, "fur.frag"}});
-  m.background_program = gl::Program(
-      {{GL_VERTEX_SHADER, "background.vert"}, {GL_FRAGMENT_SHADER, "background.frag"}});
-  m.present_program = gl::Program(
-      {{GL_VERTEX_SHADER, "background.vert"}, {GL_FRAGMENT_SHADER, "present.frag"}});
   glProgramUniform1i(m.program.id(), m.program.location("u_transfer"), 0);
-  m.color = gl::create_texture(GL_TEXTURE_2D);
-  glTextureStorage2D(m.color.id(), 1, GL_RGBA32F, m.width, m.height);
-  m.depth = gl::create_renderbuffer();
-  glNamedRenderbufferStorage(m.depth.id(), GL_DEPTH_COMPONENT32F, m.width, m.height);
-  m.fbo = gl::create_framebuffer();
-  glNamedFramebufferTexture(m.fbo.id(), GL_COLOR_ATTACHMENT0, m.color.id(), 0);
-  glNamedFramebufferRenderbuffer(m.fbo.id(), GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, m.depth.id());
-  gl::check_framebuffer(m.fbo.id(), "the fur image");
+  m.final.build(scene, m.width, m.height, 1, false);
   const Vec3f albedo = detail::fur_albedo(scene.material);
   glProgramUniform3fv(m.program.id(), m.program.location("u_albedo"), 1, albedo.data());
   m.upload_lights();
@@ -251,8 +238,7 @@ FrameStats FurRenderer::frame_stats() const {
 }
 
 std::vector<std::uint8_t> FurRenderer::read_mask() const {
-  const Impl& m = *impl_;
-  return gl::mask_from_rgba(gl::read_rgba(m.color.id(), m.width, m.height), m.width, m.height);
+  return impl_->final.read_mask();
 }
 
 void FurRenderer::set_light_sh(const std::array<ShVector<double>, 3>& light) {
@@ -260,21 +246,14 @@ void FurRenderer::set_light_sh(const std::array<ShVector<double>, 3>& light) {
 }
 
 void FurRenderer::present(float exposure, int width, int height) const {
-  const Impl& m = *impl_;
-  gl::draw_present(m.present_program, m.color.id(), m.sampler.id(), m.vao.id(), exposure, width,
-                   height);
+  impl_->final.present(exposure, width, height);
 }
 
 bool FurRenderer::render_frame() {
   Impl& m = *impl_;
   const double t0 = now_ms();
-  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, m.fbo.id());
-  glViewport(0, 0, m.width, m.height);
-  const float one = 1.0f;
-  glClearNamedFramebufferfv(m.fbo.id(), GL_DEPTH, 0, &one);
   const detail::Mat4f view_proj = detail::camera_view_proj(m.scene.camera, m.centre, m.radius);
-  gl::draw_background(m.background_program, view_proj, 0, m.sampler.id(), 1, m.scene.backdrop,
-                      m.vao.id());
+  m.final.begin_frame(view_proj, m.scene.backdrop);
   m.program.use();
   glBindVertexArray(m.vao.id());
   glBindTextureUnit(0, m.transfer.id());
@@ -307,8 +286,7 @@ bool FurRenderer::render_frame() {
 }
 
 ImageRgb FurRenderer::read_image() const {
-  const Impl& m = *impl_;
-  return gl::image_from_rgba(gl::read_rgba(m.color.id(), m.width, m.height), m.width, m.height);
+  return impl_->final.read_image();
 }
 
 double FurRenderer::precompute_ms() const { return impl_->precompute_ms; }

@@ -32,13 +32,8 @@ struct HierarchicalRenderer::Impl {
   std::unique_ptr<hbe::Solver> solver;
   gl::MeshBuffers mesh;
   gl::Buffer B;
-  gl::VertexArray empty_vao;
-  gl::Program program, background_program, present_program;
-  gl::Texture color, environment;
-  gl::Renderbuffer depth;
-  gl::Framebuffer fbo;
-  gl::Sampler linear;
-  bool has_environment = false;
+  gl::Program program;
+  gl::FinalTarget final;  // the image, its environment, background and present pass
   int width = 0, height = 0;
   Vec3f centre = Vec3f::Zero();
   float radius = 1;
@@ -105,36 +100,14 @@ void HierarchicalRenderer::setup(const Scene& scene, const hbe::Options& options
   glEnableVertexArrayAttrib(vao, 2);
   glVertexArrayAttribFormat(vao, 2, 3, GL_FLOAT, GL_FALSE, 0);
   glVertexArrayAttribBinding(vao, 2, 2);
-  m.empty_vao = gl::create_vertex_array();
   // Area lights' branches always compiled here: hbe.frag is one cheap pass.
   std::vector<std::string> defines = {"LUCENT_MAX_LIGHTS " + std::to_string(kMaxLights),
                                       "LUCENT_AREA_LIGHTS"};
   defines.push_back("LUCENT_MAX_AREA_LIGHTS " + std::to_string(gl::kMaxAreaLights));
-  m.program = gl::Program({{GL_VERTEX_SHADER, "hbe.vert"}, {GL_FRAGMENT_SHADER, "hbe.frag"}}, defines);
-  m.background_program = gl::Program(
-      {{GL_VERTEX_SHADER, "background.vert"}, {GL_FRAGMENT_SHADER, "background.frag"}}, defines);
-  m.present_program = gl::Program(
-      {{GL_VERTEX_SHADER, "background.vert"}, {GL_FRAGMENT_SHADER, "present.frag"}}, defines);
+  m.program =
+      gl::Program({{GL_VERTEX_SHADER, "hbe.vert"}, {GL_FRAGMENT_SHADER, "hbe.frag"}}, defines);
   glProgramUniform1i(m.program.id(), m.program.location("u_environment"), GLint(kUnitEnvironment));
-  glProgramUniform1i(m.background_program.id(), m.background_program.location("u_environment"),
-                     GLint(kUnitEnvironment));
-  m.linear = gl::create_sampler();
-  glSamplerParameteri(m.linear.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glSamplerParameteri(m.linear.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glSamplerParameteri(m.linear.id(), GL_TEXTURE_WRAP_S, GL_REPEAT);
-  glSamplerParameteri(m.linear.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  m.color = gl::create_texture(GL_TEXTURE_2D);
-  glTextureStorage2D(m.color.id(), 1, GL_RGBA32F, m.width, m.height);
-  m.depth = gl::create_renderbuffer();
-  glNamedRenderbufferStorage(m.depth.id(), GL_DEPTH_COMPONENT32F, m.width, m.height);
-  m.fbo = gl::create_framebuffer();
-  glNamedFramebufferTexture(m.fbo.id(), GL_COLOR_ATTACHMENT0, m.color.id(), 0);
-  glNamedFramebufferRenderbuffer(m.fbo.id(), GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, m.depth.id());
-  gl::check_framebuffer(m.fbo.id(), "the hierarchical image");
-  if (scene.environment) {
-    m.environment = gl::upload_environment(*scene.environment);
-    m.has_environment = true;
-  }
+  m.final.build(scene, m.width, m.height, kUnitEnvironment);
   m.fit_bounds();
   m.upload_lights();
   glProgramUniform1f(m.program.id(), m.program.location("u_eta"), float(scene.material.ior));
@@ -213,13 +186,8 @@ bool HierarchicalRenderer::render_frame() {
   m.upload_ms = now_ms() - t0;
 
   t0 = now_ms();
-  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, m.fbo.id());
-  glViewport(0, 0, m.width, m.height);
-  const float one = 1.0f;
-  glClearNamedFramebufferfv(m.fbo.id(), GL_DEPTH, 0, &one);
   const detail::Mat4f view_proj = detail::camera_view_proj(m.scene.camera, m.centre, m.radius);
-  gl::draw_background(m.background_program, view_proj, m.has_environment ? m.environment.id() : 0,
-                      m.linear.id(), kUnitEnvironment, m.scene.backdrop, m.empty_vao.id());
+  m.final.begin_frame(view_proj, m.scene.backdrop);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   m.program.use();
@@ -227,11 +195,7 @@ bool HierarchicalRenderer::render_frame() {
   glUniform3fv(m.program.location("u_eye"), 1, m.scene.camera.eye.data());
   glUniform1f(m.program.location("u_roughness"), m.scene.roughness);
   glUniform1i(m.program.location("u_specular"), m.scene.specular ? 1 : 0);
-  glUniform1i(m.program.location("u_has_environment"), m.has_environment ? 1 : 0);
-  if (m.has_environment) {
-    glBindTextureUnit(kUnitEnvironment, m.environment.id());
-    glBindSampler(kUnitEnvironment, m.linear.id());
-  }
+  glUniform1i(m.program.location("u_has_environment"), m.final.has_environment() ? 1 : 0);
   m.mesh.draw();
   glDisable(GL_DEPTH_TEST);
   glFinish();
@@ -242,19 +206,15 @@ bool HierarchicalRenderer::render_frame() {
 }
 
 ImageRgb HierarchicalRenderer::read_image() const {
-  const Impl& m = *impl_;
-  return gl::image_from_rgba(gl::read_rgba(m.color.id(), m.width, m.height), m.width, m.height);
+  return impl_->final.read_image();
 }
 
 std::vector<std::uint8_t> HierarchicalRenderer::read_mask() const {
-  const Impl& m = *impl_;
-  return gl::mask_from_rgba(gl::read_rgba(m.color.id(), m.width, m.height), m.width, m.height);
+  return impl_->final.read_mask();
 }
 
 void HierarchicalRenderer::present(float exposure, int width, int height) const {
-  const Impl& m = *impl_;
-  gl::draw_present(m.present_program, m.color.id(), m.linear.id(), m.empty_vao.id(), exposure,
-                   width, height);
+  impl_->final.present(exposure, width, height);
 }
 
 const hbe::Stats& HierarchicalRenderer::stats() const { return impl_->solver->stats(); }

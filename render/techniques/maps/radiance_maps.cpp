@@ -107,7 +107,7 @@ void RadianceMapRenderer::Impl::build(const Scene& s, const RenderSettings& rs,
   build_programs();
   build_light_maps();
   build_radiance_maps();
-  build_final();
+  final.build(scene, scene.camera.width, scene.camera.height, kUnitEnvironment);
   upload_layers();
   upload_material();  // and the lights with it (the disc depends on both)
   for (auto& q : queries) q = gl::create_query(GL_TIME_ELAPSED);
@@ -152,10 +152,6 @@ void RadianceMapRenderer::Impl::build_programs() {
                              defines);
   final_program =
       gl::Program({{GL_VERTEX_SHADER, "final.vert"}, {GL_FRAGMENT_SHADER, "final.frag"}}, defines);
-  background_program = gl::Program(
-      {{GL_VERTEX_SHADER, "background.vert"}, {GL_FRAGMENT_SHADER, "background.frag"}}, defines);
-  present_program = gl::Program(
-      {{GL_VERTEX_SHADER, "background.vert"}, {GL_FRAGMENT_SHADER, "present.frag"}}, defines);
 
   const auto unit = [](const gl::Program& p, const char* name, GLint u) {
     glProgramUniform1i(p.id(), p.location(name), u);
@@ -169,8 +165,6 @@ void RadianceMapRenderer::Impl::build_programs() {
   unit(final_program, "u_radiance_depth", kUnitRadianceDepth);
   unit(final_program, "u_environment", kUnitEnvironment);
   unit(final_program, "u_light_positions", kUnitLightPositionsFinal);
-  unit(background_program, "u_environment", kUnitEnvironment);
-  unit(present_program, "u_image", 0);
 
   // One sampler object per way of reading: filters and wrap modes.
   const auto sampler = [](GLint min_filter, GLint mag_filter, GLint wrap_s) {
@@ -189,8 +183,6 @@ void RadianceMapRenderer::Impl::build_programs() {
   shadow = sampler(GL_NEAREST, GL_NEAREST, GL_CLAMP_TO_EDGE);
   glSamplerParameteri(shadow.id(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
   glSamplerParameteri(shadow.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
-  // Lat-long: wrap in u, clamp in v (as environment_lookup on the CPU).
-  environment_sampler = sampler(GL_LINEAR, GL_LINEAR, GL_REPEAT);
 }
 
 void RadianceMapRenderer::Impl::build_light_maps() {
@@ -251,29 +243,6 @@ void RadianceMapRenderer::Impl::build_radiance_maps() {
   disc_buffer = gl::create_buffer();
   glNamedBufferStorage(disc_buffer.id(), GLsizeiptr(settings.samples * 16), nullptr,
                        GL_DYNAMIC_STORAGE_BIT);
-}
-
-void RadianceMapRenderer::Impl::build_final() {
-  final_width = scene.camera.width;
-  final_height = scene.camera.height;
-  if (final_width < 1 || final_height < 1) throw Error("--size: the image has no pixels");
-  final_color = gl::create_texture(GL_TEXTURE_2D);
-  glTextureStorage2D(final_color.id(), 1, GL_RGBA32F, final_width, final_height);
-  glTextureParameteri(final_color.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTextureParameteri(final_color.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  final_depth = gl::create_renderbuffer();
-  glNamedRenderbufferStorage(final_depth.id(), GL_DEPTH_COMPONENT32F, final_width, final_height);
-  final_fbo = gl::create_framebuffer();
-  glNamedFramebufferTexture(final_fbo.id(), GL_COLOR_ATTACHMENT0, final_color.id(), 0);
-  glNamedFramebufferRenderbuffer(final_fbo.id(), GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
-                                 final_depth.id());
-  gl::check_framebuffer(final_fbo.id(), "the final image");
-
-  has_environment = false;
-  if (scene.environment) {
-    environment = gl::upload_environment(*scene.environment);
-    has_environment = true;
-  }
 }
 
 void RadianceMapRenderer::Impl::upload_layers() {
@@ -498,14 +467,8 @@ void RadianceMapRenderer::Impl::render_blur() {
 }
 
 void RadianceMapRenderer::Impl::render_final() {
-  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, final_fbo.id());
-  glViewport(0, 0, final_width, final_height);
-  const float one = 1.0f;
-  glClearNamedFramebufferfv(final_fbo.id(), GL_DEPTH, 0, &one);
   const detail::Mat4f view_proj = detail::camera_view_proj(scene.camera, centre, radius_mm);
-
-  gl::draw_background(background_program, view_proj, has_environment ? environment.id() : 0,
-                      environment_sampler.id(), kUnitEnvironment, scene.backdrop, empty_vao.id());
+  final.begin_frame(view_proj, scene.backdrop);
 
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
@@ -522,7 +485,7 @@ void RadianceMapRenderer::Impl::render_final() {
   glUniform1f(final_program.location("u_shrink_mm"), options.shrink_texels * texel_mm);
   glUniform3fv(final_program.location("u_eye"), 1, scene.camera.eye.data());
   glUniform1i(final_program.location("u_has_environment"),
-              has_environment && options.environment_reflection ? 1 : 0);
+              final.has_environment() && options.environment_reflection ? 1 : 0);
   glUniform1f(final_program.location("u_roughness"), scene.roughness);
   glUniform1i(final_program.location("u_specular"), scene.specular ? 1 : 0);
   glBindBufferBase(GL_UNIFORM_BUFFER, kLayerCamerasBinding, layer_cameras.id());
@@ -537,7 +500,7 @@ void RadianceMapRenderer::Impl::render_final() {
 }
 
 std::vector<float> RadianceMapRenderer::Impl::read_rgba() const {
-  return gl::read_rgba(final_color.id(), final_width, final_height);
+  return final.read_rgba();
 }
 
 void RadianceMapRenderer::Impl::record_convergence() {

@@ -9,9 +9,8 @@
 namespace lucent::render {
 
 void RadianceMapRenderer::set_camera(const Camera& camera) {
-  if (camera.width != impl_->final_width || camera.height != impl_->final_height) {
-    impl_->scene.camera = camera;
-    impl_->build_final();
+  if (camera.width != impl_->final.width() || camera.height != impl_->final.height()) {
+    impl_->final.resize(camera.width, camera.height);
   }
   impl_->scene.camera = camera;
 }
@@ -114,18 +113,17 @@ bool RadianceMapRenderer::converged() const {
 
 ImageRgb RadianceMapRenderer::read_image() const {
   const Impl& m = *impl_;
-  return gl::image_from_rgba(m.read_rgba(), m.final_width, m.final_height);
+  return m.final.read_image();
 }
 
 std::vector<std::uint8_t> RadianceMapRenderer::read_mask() const {
   const Impl& m = *impl_;
-  return gl::mask_from_rgba(m.read_rgba(), m.final_width, m.final_height);
+  return m.final.read_mask();
 }
 
 void RadianceMapRenderer::present(float exposure, int width, int height) const {
   const Impl& m = *impl_;
-  gl::draw_present(m.present_program, m.final_color.id(), m.linear_clamp.id(), m.empty_vao.id(),
-                   exposure, width, height);
+  m.final.present(exposure, width, height);
 }
 
 const RadianceMapStats& RadianceMapRenderer::stats() const {

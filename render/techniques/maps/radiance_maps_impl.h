@@ -65,13 +65,11 @@ struct RadianceMapRenderer::Impl {
   Vec3f centre{0, 0, 0};
   float radius_mm = 1;
   int K = 0, L = 0;
-  int final_width = 0, final_height = 0;
 
   gl::MeshBuffers mesh;
   gl::VertexArray empty_vao;
 
-  gl::Program light_map_program, radiance_program, blur_program, final_program, background_program,
-      present_program;
+  gl::Program light_map_program, radiance_program, blur_program, final_program;
 
   gl::Buffer light_matrices, layer_cameras, disc_buffer;
   gl::Texture light_positions, light_normals, light_face_normals, light_depth;
@@ -84,13 +82,9 @@ struct RadianceMapRenderer::Impl {
   std::array<std::vector<gl::Texture>, 2> level_views;     // [buffer][l]: level l alone
   std::array<std::vector<gl::Framebuffer>, 2> level_fbos;  // [buffer][l]: draws level l + 1
 
-  gl::Sampler nearest, linear_clamp, mip_nearest, shadow, environment_sampler;
-  gl::Texture final_color;
-  gl::Renderbuffer final_depth;
-  gl::Framebuffer final_fbo;
-  gl::Texture environment;
+  gl::Sampler nearest, linear_clamp, mip_nearest, shadow;
+  gl::FinalTarget final;       // the image, its environment, background and present pass
   gl::Texture tabulated_rows;  // the tabulated model's three rows (bssrdf_tabulated.glsl)
-  bool has_environment = false;
 
   std::vector<detail::LayerCamera> layer_cams, light_cams;
   detail::DiscPoints disc_points;  // drawn by upload_lights
@@ -110,7 +104,6 @@ struct RadianceMapRenderer::Impl {
   void build_programs();
   void build_light_maps();
   void build_radiance_maps();
-  void build_final();
   void upload_lights();
   void upload_light_cameras(int t);  ///< t: the accumulated frame (area lights' points)
   bool has_area_lights() const {

@@ -164,10 +164,6 @@ void ShRenderer::Impl::build_programs() {
       {{GL_VERTEX_SHADER, "sh_cube.vert"}, {GL_FRAGMENT_SHADER, "sh_cube.frag"}}, defines);
   final_program = gl::Program(
       {{GL_VERTEX_SHADER, "final.vert"}, {GL_FRAGMENT_SHADER, "sh_final.frag"}}, defines);
-  background_program = gl::Program(
-      {{GL_VERTEX_SHADER, "background.vert"}, {GL_FRAGMENT_SHADER, "background.frag"}}, defines);
-  present_program = gl::Program(
-      {{GL_VERTEX_SHADER, "background.vert"}, {GL_FRAGMENT_SHADER, "present.frag"}}, defines);
   projector = std::make_unique<Projector>(options.cube_map_size);
   const auto unit = [](const gl::Program& p, const char* name, GLint u) {
     glProgramUniform1i(p.id(), p.location(name), u);
@@ -179,12 +175,7 @@ void ShRenderer::Impl::build_programs() {
   unit(final_program, "u_blurred_depth", kUnitBlurred);
   unit(final_program, "u_second_depth", kUnitSecond);
   unit(final_program, "u_environment", kUnitEnvironment);
-  unit(background_program, "u_environment", kUnitEnvironment);
-  unit(present_program, "u_image", 0);
   nearest = make_sampler(GL_NEAREST);
-  linear = make_sampler(GL_LINEAR);
-  environment_sampler = make_sampler(GL_LINEAR);
-  glSamplerParameteri(environment_sampler.id(), GL_TEXTURE_WRAP_S, GL_REPEAT);
 }
 
 void ShRenderer::Impl::build_targets() {
@@ -220,21 +211,7 @@ void ShRenderer::Impl::build_targets() {
     gl::check_framebuffer(fbo, "the sh cube map");
   }
 
-  final_color = gl::create_texture(GL_TEXTURE_2D);
-  glTextureStorage2D(final_color.id(), 1, GL_RGBA32F, width, height);
-  final_depth = gl::create_renderbuffer();
-  glNamedRenderbufferStorage(final_depth.id(), GL_DEPTH_COMPONENT32F, width, height);
-  final_fbo = gl::create_framebuffer();
-  glNamedFramebufferTexture(final_fbo.id(), GL_COLOR_ATTACHMENT0, final_color.id(), 0);
-  glNamedFramebufferRenderbuffer(final_fbo.id(), GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
-                                 final_depth.id());
-  gl::check_framebuffer(final_fbo.id(), "the final image");
-
-  has_environment = false;
-  if (scene.environment) {
-    environment = gl::upload_environment(*scene.environment);
-    has_environment = true;
-  }
+  final.build(scene, width, height, kUnitEnvironment);
 }
 
 void ShRenderer::Impl::fit_bounds() {
@@ -395,13 +372,8 @@ void ShRenderer::Impl::cube_pass() {
 }
 
 void ShRenderer::Impl::final_pass() {
-  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, final_fbo.id());
-  glViewport(0, 0, width, height);
-  const float one = 1.0f;
-  glClearNamedFramebufferfv(final_fbo.id(), GL_DEPTH, 0, &one);
   const detail::Mat4f view_proj = detail::camera_view_proj(scene.camera, centre, radius_mm);
-  gl::draw_background(background_program, view_proj, has_environment ? environment.id() : 0,
-                      environment_sampler.id(), kUnitEnvironment, scene.backdrop, empty_vao.id());
+  final.begin_frame(view_proj, scene.backdrop);
 
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
@@ -410,7 +382,7 @@ void ShRenderer::Impl::final_pass() {
   glUniform3fv(final_program.location("u_eye"), 1, scene.camera.eye.data());
   glUniform1f(final_program.location("u_roughness"), scene.roughness);
   glUniform1i(final_program.location("u_specular"), scene.specular ? 1 : 0);
-  glUniform1i(final_program.location("u_has_environment"), has_environment ? 1 : 0);
+  glUniform1i(final_program.location("u_has_environment"), final.has_environment() ? 1 : 0);
   glUniform1i(final_program.location("u_output"), int(output));
   glBindTextureUnit(kUnitFirst, first.id());
   glBindSampler(kUnitFirst, nearest.id());

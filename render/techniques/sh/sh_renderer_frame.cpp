@@ -94,15 +94,11 @@ bool ShRenderer::render_frame() {
 }
 
 ImageRgb ShRenderer::read_image() const {
-  const Impl& m = *impl_;
-  return gl::image_from_rgba(gl::read_rgba(m.final_color.id(), m.width, m.height), m.width,
-                             m.height);
+  return impl_->final.read_image();
 }
 
 std::vector<std::uint8_t> ShRenderer::read_mask() const {
-  const Impl& m = *impl_;
-  return gl::mask_from_rgba(gl::read_rgba(m.final_color.id(), m.width, m.height), m.width,
-                            m.height);
+  return impl_->final.read_mask();
 }
 
 std::array<std::array<float, 9>, 3> ShRenderer::read_coefficients() const {
@@ -118,9 +114,7 @@ std::vector<float> ShRenderer::read_cube_map() const {
 }
 
 void ShRenderer::present(float exposure, int width, int height) const {
-  const Impl& m = *impl_;
-  gl::draw_present(m.present_program, m.final_color.id(), m.linear.id(), m.empty_vao.id(),
-                   exposure, width, height);
+  impl_->final.present(exposure, width, height);
 }
 
 const ShStats& ShRenderer::stats() const {

@@ -100,8 +100,7 @@ struct ShRenderer::Impl {
 
   gl::MeshBuffers mesh;
   gl::VertexArray empty_vao;
-  gl::Program depth_program, blur_program, cube_program, final_program, background_program,
-      present_program;
+  gl::Program depth_program, blur_program, cube_program, final_program;
   std::unique_ptr<Projector> projector;
 
   gl::Texture first, second, blur_temp, blurred;
@@ -110,12 +109,8 @@ struct ShRenderer::Impl {
   gl::Texture cube;
   gl::Renderbuffer cube_depth;
   std::array<gl::Framebuffer, 6> cube_fbos;
-  gl::Texture final_color;
-  gl::Renderbuffer final_depth;
-  gl::Framebuffer final_fbo;
-  gl::Texture environment;
-  bool has_environment = false;
-  gl::Sampler nearest, linear, environment_sampler;
+  gl::FinalTarget final;  // the image, its environment, background and present pass
+  gl::Sampler nearest;
   std::array<gl::Query, kPassCount> queries;
 
   detail::LayerCamera light_camera;
