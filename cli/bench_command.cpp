@@ -9,13 +9,14 @@
 #include "lucent/fit/fit_bench.h"
 #include "lucent/render/render_bench.h"
 #include "lucent/render/tradeoff_bench.h"
+#include "technique_flags.h"
 
 namespace lucent::cli {
+namespace {
 
-void register_bench_command(CLI::App& app) {
-  CLI::App* bench =
-      app.add_subcommand("bench", "Speed against accuracy sweeps; CSV and plots to --out-dir");
-  bench->require_subcommand(1);
+// `lucent bench fit`: the fit's quality, model and derivatives swept over captures with known
+// truth.
+void register_fit_bench(CLI::App* bench) {
   auto options = std::make_shared<fit::FitBenchOptions>();
   CLI::App* fit_cmd = bench->add_subcommand(
       "fit",
@@ -36,7 +37,10 @@ void register_bench_command(CLI::App& app) {
     std::cout << "bench fit: " << n << " settings; wrote "
               << (options->out_dir / "fit_tradeoff.csv").string() << " and fit_tradeoff.png\n";
   });
+}
 
+// `lucent bench render`: per-stage times of the radiance-map technique.
+void register_render_bench(CLI::App* bench) {
   auto render_options = std::make_shared<render::RenderBenchOptions>();
   CLI::App* render_cmd = bench->add_subcommand(
       "render",
@@ -48,16 +52,13 @@ void register_bench_command(CLI::App& app) {
   render_cmd->add_option("--frames", render_options->frames, "frames timed per mesh")
       ->capture_default_str();
   render_cmd->add_option("--size", render_options->size, "image size, pixels")->capture_default_str();
-  render_cmd->add_option("--directions", rs.directions, "K")->capture_default_str();
-  render_cmd->add_option("--samples", rs.samples, "N")->capture_default_str();
-  render_cmd->add_option("--disc-points", rs.disc_points, "M")->capture_default_str();
-  render_cmd->add_option("--radiance-map", rs.radiance_map_size, "W_s, texels")->capture_default_str();
-  render_cmd->add_option("--light-map", rs.light_map_size, "W_l, texels")->capture_default_str();
+  add_maps_sampling_flags(render_cmd, rs);
   auto selections = std::make_shared<std::vector<std::string>>(
       std::vector<std::string>{"strata", "nearest"});
   render_cmd->add_option("--disc-selection", *selections, "disc selections to time (rows each)")
       ->capture_default_str();
-  render_cmd->callback([render_options, selections] {
+  render_cmd->callback([render_options, selections, render_cmd] {
+    warn_deprecated_flags(render_cmd);
     check_output_folder(render_options->out_csv);  // before the sweep, not after
     render_options->disc_selections.clear();
     for (const auto& text : *selections) {
@@ -67,7 +68,10 @@ void register_bench_command(CLI::App& app) {
     std::cout << "bench render: " << n << " meshes; wrote " << render_options->out_csv.string()
               << "\n";
   });
+}
 
+// `lucent bench fur`: the fur tile's precompute and draw times per shell count.
+void register_fur_bench(CLI::App* bench) {
   auto fur_options = std::make_shared<render::FurBenchOptions>();
   auto fur_size = std::make_shared<std::string>("1280x1024");
   CLI::App* fur_cmd = bench->add_subcommand(
@@ -102,7 +106,10 @@ void register_bench_command(CLI::App& app) {
     const int n = render::run_fur_bench(*fur_options, std::cout);
     std::cout << "bench fur: " << n << " rows; wrote " << fur_options->out_csv.string() << '\n';
   });
+}
 
+// `lucent bench tradeoff`: every technique's knobs swept against a converged CPU reference.
+void register_tradeoff_bench(CLI::App* bench) {
   auto tradeoff = std::make_shared<render::TradeoffBenchOptions>();
   auto sweep = std::make_shared<std::string>("full");
   CLI::App* tradeoff_cmd = bench->add_subcommand(
@@ -138,6 +145,18 @@ void register_bench_command(CLI::App& app) {
               << (tradeoff->out_dir / "tradeoff.csv").string()
               << ", tradeoff.png, tradeoff.svg and tradeoff_summary.md\n";
   });
+}
+
+}  // namespace
+
+void register_bench_command(CLI::App& app) {
+  CLI::App* bench =
+      app.add_subcommand("bench", "Speed against accuracy sweeps; CSV and plots to --out-dir");
+  bench->require_subcommand(1);
+  register_fit_bench(bench);
+  register_render_bench(bench);
+  register_fur_bench(bench);
+  register_tradeoff_bench(bench);
 }
 
 }  // namespace lucent::cli

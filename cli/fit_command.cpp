@@ -110,9 +110,9 @@ fit::FitOptions to_options(const FitArguments& a) {
   return o;
 }
 
-materials::Material run(const FitArguments& a) {
-  fit::FitOptions options = to_options(a);
-  // Where the outputs go is checked before the fit (they are written together at the end).
+// Stage 1 of a fit: where the outputs go is checked before the fit (they are written together at
+// the end).
+void check_fit_outputs(const FitArguments& a) {
   check_output_file(a.output, ".json", "-o");
   if (!a.plot.empty()) {
     check_output_file(a.plot, "", "--plot");
@@ -120,6 +120,12 @@ materials::Material run(const FitArguments& a) {
   }
   if (!a.report.empty()) check_output_file(a.report, ".json", "--report");
   check_distinct_outputs({{"-o", a.output}, {"--plot", a.plot}, {"--report", a.report}});
+}
+
+// Stage 2 of a fit: the profiles read, each with an index from itself or the options, and the
+// beam image applied to them.
+std::vector<fit::ProfileData> load_fit_inputs(const FitArguments& a,
+                                              const fit::FitOptions& options) {
   std::vector<fit::ProfileData> data;
   for (const std::string& input : a.inputs) {
     data.push_back(fit::load_profile_data(input));
@@ -134,8 +140,20 @@ materials::Material run(const FitArguments& a) {
       throw Error("--beam-image: the beam is given either as an image or as --beam-sigma-mm");
     use_beam_image(data, a.beam_image, a.beam_pixel_mm);
   }
-  materials::TransportTable table;
+  return data;
+}
+
+// The tables a fit's options point to; they live as long as the options are used.
+struct FitTables {
+  materials::TransportTable given;  // --table
+  std::optional<materials::TransportTable> oblique;
+};
+
+// Stage 3 of a fit: the transport tables it uses (given, cached or built now) set in `options`.
+void choose_fit_tables(const FitArguments& a, const std::vector<fit::ProfileData>& data,
+                       fit::FitOptions& options, FitTables& tables) {
   if (!a.table.empty()) {
+    materials::TransportTable& table = tables.given;
     table = materials::read_transport_table(a.table);
     // Given on purpose, so a table that cannot serve a radial fit is an error, not a quiet fall
     // back to the diffusion models.
@@ -153,17 +171,14 @@ materials::Material run(const FitArguments& a) {
           radial_table_for(data, options, a.table_photons, a.json || a.quiet || a.no_progress))
     options.table = radial;
   options.slab = slab_nodes_for(data, options, a.slab_photons, a.json || a.quiet || a.no_progress);
-  const std::optional<materials::TransportTable> oblique =
-      oblique_table_for(data, options, a.oblique_table, a.oblique_photons, a.json);
-  if (oblique) options.oblique_table = &*oblique;
-  StageProgress progress("fit", a.quiet || a.no_progress);
-  options.progress = [&](const std::string& stage, double done) { progress.stage(stage, done); };
-  const fit::FitResult result = fit::fit_profiles(data, options);
-  progress.finish();
-  std::string name = a.name;
-  if (name.empty()) name = std::filesystem::path(a.output).stem().string();
-  const materials::Material material = fit::fitted_material(result, data, options, name);
-  // Everything is computed before anything is written; each file is written atomically.
+  tables.oblique = oblique_table_for(data, options, a.oblique_table, a.oblique_photons, a.json);
+  if (tables.oblique) options.oblique_table = &*tables.oblique;
+}
+
+// Stage 5 of a fit: the plot, the report and the material file, each written atomically.
+void write_fit_outputs(const FitArguments& a, const fit::FitResult& result,
+                       const std::vector<fit::ProfileData>& data, const fit::FitOptions& options,
+                       const materials::Material& material) {
   if (!a.plot.empty()) {
     fit::FitPlotOptions plot_options;
     plot_options.log_r = a.plot_log_r;
@@ -180,19 +195,12 @@ materials::Material run(const FitArguments& a) {
     write_file_atomically(a.report, report.dump(2) + "\n");
   }
   materials::write_material(a.output, material);
+}
 
+// A fit's summary as text: the chosen model's coefficients per channel, the thickness, how g
+// moves the answer, the cheapest adequate model, notes and warnings.
+void print_fit_summary(const FitArguments& a, const fit::FitResult& result) {
   const fit::ModelFit& f = result.chosen;
-  if (a.quiet) {
-    for (const std::string& w : result.warnings)
-      warn("lucent fit: " + a.output + ": warning: " + w);
-    return material;
-  }
-  if (a.json) {
-    nlohmann::json j = fit::fit_report(result, data, options);
-    j["output"] = a.output;
-    std::cout << j.dump(2) << '\n';
-    return material;
-  }
   const char* names[3] = {"R", "G", "B"};
   std::cout << "fitted " << fit::to_string(f.model) << " (" << result.reason << ")\n";
   for (int c = 0; c < 3; ++c) {
@@ -239,6 +247,42 @@ materials::Material run(const FitArguments& a) {
   for (const std::string& note : result.notes) std::cout << "  note: " << note << '\n';
   for (const std::string& w : result.warnings) warn("lucent fit: warning: " + w);
   std::cout << "wrote " << a.output << '\n';
+}
+
+// Stage 6 of a fit: what it says; a batch row only its warnings, --json the report.
+void report_fit(const FitArguments& a, const fit::FitResult& result,
+                const std::vector<fit::ProfileData>& data, const fit::FitOptions& options) {
+  if (a.quiet) {
+    for (const std::string& w : result.warnings)
+      warn("lucent fit: " + a.output + ": warning: " + w);
+    return;
+  }
+  if (a.json) {
+    nlohmann::json j = fit::fit_report(result, data, options);
+    j["output"] = a.output;
+    std::cout << j.dump(2) << '\n';
+    return;
+  }
+  print_fit_summary(a, result);
+}
+
+materials::Material run(const FitArguments& a) {
+  fit::FitOptions options = to_options(a);
+  check_fit_outputs(a);
+  const std::vector<fit::ProfileData> data = load_fit_inputs(a, options);
+  FitTables tables;
+  choose_fit_tables(a, data, options, tables);
+  // Stage 4: the fit itself.
+  StageProgress progress("fit", a.quiet || a.no_progress);
+  options.progress = [&](const std::string& stage, double done) { progress.stage(stage, done); };
+  const fit::FitResult result = fit::fit_profiles(data, options);
+  progress.finish();
+  std::string name = a.name;
+  if (name.empty()) name = std::filesystem::path(a.output).stem().string();
+  const materials::Material material = fit::fitted_material(result, data, options, name);
+  // Everything is computed before anything is written.
+  write_fit_outputs(a, result, data, options, material);
+  report_fit(a, result, data, options);
   return material;
 }
 

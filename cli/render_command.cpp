@@ -64,12 +64,11 @@ void run_render(RenderArguments& render_args) {
   if (!technique.frame_snapshots && !render_args.snapshots.empty()) {
     throw Error("--snapshots: frame snapshots are of the radiance maps (--technique maps)");
   }
-  TechniqueOptions options{args.settings, {}, args.sh, args.hbe, args.fur, args.reference};
-  options.maps.max_blur_level = args.max_blur;
+  TechniqueOptions options = args.options;
   for (int t : render_args.snapshots) {
-    if (t < 1 || t > args.settings.frames) {
-      throw Error("--snapshots: frames must be 1.." + std::to_string(args.settings.frames) +
-                  " (--frames), got " + std::to_string(t));
+    if (t < 1 || t > options.settings.frames) {
+      throw Error("--snapshots: frames must be 1.." + std::to_string(options.settings.frames) +
+                  " (--maps-frames), got " + std::to_string(t));
     }
   }
   options.maps.snapshot_frames = render_args.snapshots;
@@ -88,7 +87,7 @@ void run_render(RenderArguments& render_args) {
   if (progress_shown) std::fprintf(stderr, "\n");
 
   ToneMapOptions tone;
-  tone.exposure = args.auto_exposure ? auto_exposure(image) : args.settings.exposure;
+  tone.exposure = args.auto_exposure ? auto_exposure(image) : options.settings.exposure;
   write_render_image(render_args.output, image, tone,
                      {{"lucent:units", "radiance, W mm^-2 sr^-1 per unit light"},
                       {"lucent:material", scene.material.name},
@@ -101,7 +100,7 @@ void run_render(RenderArguments& render_args) {
   const bool png = extension == ".png";  // EXR is written linear, without the exposure
   nlohmann::json doc = stats.to_json();
   doc["scene"] = {{"material", scene.material.name},
-                  {"model", materials::to_string(args.settings.model)},
+                  {"model", materials::to_string(options.settings.model)},
                   {"mesh", scene.mesh.name},
                   {"triangles", scene.mesh.triangles.size()},
                   {"object_size_mm", args.object_size_mm},
@@ -127,7 +126,7 @@ void run_render(RenderArguments& render_args) {
     std::printf(
         "render: wrote %s (%dx%d, %s, %s on %s, %s%s) in %.1f s\n", render_args.output.c_str(),
         scene.camera.width, scene.camera.height, technique.label.c_str(),
-        materials::to_string(args.settings.model).c_str(), scene.mesh.name.c_str(),
+        materials::to_string(options.settings.model).c_str(), scene.mesh.name.c_str(),
         png ? "exposure " : "linear",
         png ? (std::to_string(tone.exposure) + (args.auto_exposure ? " (auto)" : "")).c_str() : "",
         seconds);

@@ -1,6 +1,7 @@
 // The options `lucent render` and `lucent view` share (see scene_options.h).
 #include "scene_options.h"
 
+#include "technique_flags.h"
 #include "validators.h"
 
 #include <algorithm>
@@ -119,94 +120,9 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
   cmd->add_option("--backdrop", args->backdrop,
                   "R,G,B: radiance of the background where there is no environment map "
                   "(default black)");
-  cmd->add_option("--reference-sampling", args->reference_sampling,
-                  "reference: probes (points drawn from the profile around each pixel, found by "
-                  "probe rays; noise ~ 1/sqrt(--samples-pixel)) or area (--samples-reference "
-                  "uniform surface samples shared by all pixels)")
-      ->capture_default_str();
-  cmd->add_option("--samples-pixel", args->reference.pixel_samples,
-                  "reference (probes): probes per pixel per pass")
-      ->check(whole_in(1, 10000000, "probes per pixel"))
-      ->capture_default_str();
-  cmd->add_option("--samples-reference", args->reference.surface_samples,
-                  "reference (area): surface samples per pass (uniform by area)")
-      ->check(whole_in(1, 1000000000, "surface samples"))
-      ->capture_default_str();
-  cmd->add_option("--area-light-samples", args->reference.area_light_samples,
-                  "reference: points on each area light (shadow rays) per surface point, "
-                  "stratified, with the analytic form factor as control variate")
-      ->check(whole_in(1, 4096, "area light samples"))
-      ->capture_default_str();
-  cmd->add_option("--irradiance-cache", args->irradiance_cache,
-                  "reference (probes): on: area lights' irradiance from per-cluster projection "
-                  "maps (Jacob 1993; bilinear between grid vertices evaluated once) instead of "
-                  "shadow rays at every hit")
-      ->capture_default_str();
-  cmd->add_option("--passes", args->reference.passes,
-                  "reference: progressive passes, each with new samples (image = their mean)")
-      ->check(whole_in(1, 1000000, "passes"))
-      ->capture_default_str();
-  cmd->add_option("--threads", args->reference.threads, "reference: worker threads (0 = all)")
-      ->check(thread_count())
-      ->capture_default_str();
-  cmd->add_option("--seed", args->reference.seed,
+  cmd->add_option("--seed", args->options.reference.seed,
                   "random seed (reference samples, environment-light placement)")
       ->check(seed_value())
-      ->capture_default_str();
-  cmd->add_option("--frames", args->settings.frames, "maps: T, frames accumulated")
-      ->capture_default_str();
-  cmd->add_option("--directions", args->settings.directions,
-                  "maps: K, radiance-map directions (Halton points on the sphere)")
-      ->capture_default_str();
-  cmd->add_option("--samples", args->settings.samples,
-                  "maps: N, disc samples gathered per texel per frame (N <= M)")
-      ->capture_default_str();
-  cmd->add_option("--disc-points", args->settings.disc_points,
-                  "maps: M, disc points (a quadrature of the disc around each texel)")
-      ->capture_default_str();
-  cmd->add_option("--disc-distribution", args->disc_distribution,
-                  "maps: profile (radii importance-sampled from the material's own profile, "
-                  "weights exact at any texel size) or exponential (Dal Corso 2014: e^(-sigma* r), "
-                  "sigma* = min sigma_tr / q)")
-      ->capture_default_str();
-  cmd->add_option("--q", args->settings.q,
-                  "maps: q, disc bias sigma* = min sigma_tr / q (q > 1 spreads the samples wider)")
-      ->capture_default_str();
-  cmd->add_option("--disc-selection", args->disc_selection,
-                  "maps: which N of the M points a frame gathers: strata (one of each of N radius "
-                  "strata, a new one every frame: converges to all M after M/N frames) or nearest "
-                  "(Dal Corso 2014: the N nearest, every frame; misses the far profile)")
-      ->capture_default_str();
-  cmd->add_option("--shadow-map", args->sh.shadow_map_size,
-                  "sh: the primary light's shadow map (and depth peel), texels per side")
-      ->capture_default_str();
-  cmd->add_option("--cube-map", args->sh.cube_map_size,
-                  "sh: texels per face of the external cube map of the lit object")
-      ->capture_default_str();
-  cmd->add_option("--depth-blur", args->sh.depth_blur_sigma_texels,
-                  "sh: sigma of the Gaussian blur of the light's depth map, shadow-map texels (0: "
-                  "none)")
-      ->capture_default_str();
-  cmd->add_option("--sh-fresnel", args->sh_fresnel,
-                  "sh: F_t in the cube map: exact (unpolarised Fresnel) or schlick (the seed's)")
-      ->capture_default_str();
-  cmd->add_option("--sh-attenuation", args->sh_attenuation,
-                  "sh: the attenuation in the thickness: seed (eq. 12 as printed, guarded), "
-                  "normalised (eq. 12 scaled to R_tot at d = 0) or slab (eq. 12 integrated over "
-                  "the plane, scaled to R_tot at d = 0)")
-      ->capture_default_str();
-  cmd->add_option("--fur-texels", args->fur.texels, "fur: the tile's texels across (seed: 64)")
-      ->check(whole_in(2, 4096, "fur texels"))
-      ->capture_default_str();
-  cmd->add_option("--fur-shells", args->fur.shells, "fur: shells (seed: 32)")
-      ->check(whole_in(1, 1024, "fur shells"))
-      ->capture_default_str();
-  cmd->add_option("--fur-seed", args->fur.seed, "fur: the hair generator's seed")
-      ->capture_default_str();
-  cmd->add_option("--fur-coverage", args->fur_coverage,
-                  "fur: a hair's cross-section over the texels: exact (the disc's overlap with "
-                  "each texel) or seed (its chord and wedge approximations, eqs. 1-2: the wedge "
-                  "is 13-32% off once a disc leaves the texel corner)")
       ->capture_default_str();
   cmd->add_option(
          "--fur-coat", args->fur_coat,
@@ -214,62 +130,18 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
          "T(cos theta), from the --fur-* hairs, attenuates the light entering the skin "
          "(maps, hierarchical, reference)")
       ->capture_default_str();
-  cmd->add_option("--fur-tile-mm", args->fur.tile_mm,
-                  "fur over a mesh: the tile's width, mm (its texels set the hair scale)")
-      ->capture_default_str();
-  cmd->add_option("--fur-height-mm", args->fur.height_mm, "fur over a mesh: the coat's height, mm")
-      ->capture_default_str();
-  cmd->add_option("--hbe-irradiance-cache", args->hbe_irradiance_cache,
-                  "hierarchical: on: area lights' leaf irradiance from per-cluster projection maps "
-                  "(Jacob 1993) built once; off: 16 shadow rays per leaf every frame")
-      ->capture_default_str();
-  cmd->add_option("--hbe-mode", args->hbe_mode,
-                  "hierarchical: render (links kept), incremental (links repaired within "
-                  "--hbe-budget per frame) or on-the-fly (no stored links)")
-      ->capture_default_str();
-  cmd->add_option("--hbe-epsilon1", args->hbe.epsilon_1,
-                  "hierarchical: split the receiver when the emitter's solid angle seen from its "
-                  "children deviates by more than this, sr")
-      ->capture_default_str();
-  cmd->add_option("--hbe-epsilon2", args->hbe.epsilon_2,
-                  "hierarchical: split the emitter when its solid angle exceeds this, sr")
-      ->capture_default_str();
-  cmd->add_option("--hbe-near", args->hbe.near,
-                  "hierarchical: links above this solid angle (sr) use the semi-analytic form "
-                  "factor, the others one midpoint sample")
-      ->capture_default_str();
-  cmd->add_option("--hbe-planarity", args->hbe.min_planarity,
-                  "hierarchical: near emitter clusters less planar than this A'/A are split")
-      ->capture_default_str();
-  cmd->add_option("--hbe-edge-constant", args->hbe.form_factor.edge_constant,
-                  "hierarchical: split edge segments until L/r0 < c and L sigma_tr < c (seed: 0.4)")
-      ->capture_default_str();
-  cmd->add_option("--hbe-rule", args->hbe_rule,
-                  "hierarchical: per segment, midpoint (the seed's eq. 17) or gauss2 (two-point "
-                  "Gauss-Legendre)")
-      ->capture_default_str();
-  cmd->add_option("--hbe-dipole", args->hbe_dipole,
-                  "hierarchical: chord (R_d of the chord distance, lucent's, as the reference) or "
-                  "seed (sources at x_o -/+ z n_o)")
-      ->capture_default_str();
-  cmd->add_option("--hbe-budget", args->hbe.budget,
-                  "hierarchical, incremental: link factors evaluated per frame")
-      ->capture_default_str();
-  cmd->add_option("--max-blur", args->max_blur,
-                  "maps: mip blur levels at the first frame, fewer as frames accumulate (0 = none; "
-                  "-1: none with the profile disc, 2 with the exponential one)")
-      ->capture_default_str();
-  cmd->add_option("--radiance-map", args->settings.radiance_map_size,
-                  "maps: W_s, radiance-map size in texels")
-      ->capture_default_str();
-  cmd->add_option("--light-map", args->settings.light_map_size,
-                  "maps: W_l, light-map size in texels")
-      ->capture_default_str();
+  add_technique_flags(cmd, args->options);
+  args->on_valid = [cmd] { warn_deprecated_flags(cmd); };
 }
 
-SceneSetup build_scene(SceneArguments& args) {
-  using namespace lucent::render;
-  // Everything that needs no file first, so that typing errors fail before any loading.
+namespace {
+
+// --size and --view, checked: {width, height} and {azimuth, elevation, distance}.
+struct CameraArguments {
+  std::vector<double> size, view;
+};
+
+CameraArguments parse_camera(const SceneArguments& args) {
   const auto size = parse_numbers(args.size, "--size", 2, 'x', "WxH in pixels, e.g. 256x256");
   if (size[0] < 1 || size[1] < 1 || size[0] > 16384 || size[1] > 16384 ||
       size[0] != std::floor(size[0]) || size[1] != std::floor(size[1])) {
@@ -282,62 +154,41 @@ SceneSetup build_scene(SceneArguments& args) {
     throw Error("--view: expected AZ in [-3600, 3600] degrees, EL in [-90, 90] degrees and DIST "
                 "in (0, 1e4] bounding radii, got '" + args.view + "'");
   }
-  args.technique_id = render::parse_technique(args.technique);
-  const render::TechniqueInfo& technique = render::technique_info(args.technique_id);
-  args.hbe.mode = render::hbe::parse_mode(args.hbe_mode);
-  args.hbe.form_factor.rule = render::hbe::parse_segment_rule(args.hbe_rule);
-  args.hbe.form_factor.placement = render::hbe::parse_dipole_placement(args.hbe_dipole);
-  args.hbe.validate();
+  return {size, view};
+}
+
+// Every option that needs no file, checked before anything is loaded; the fur's hair counts set
+// from its tile.
+void check_options(SceneArguments& args, const render::TechniqueInfo& technique) {
+  using render::TechniqueOptions;
+  TechniqueOptions& o = args.options;
+  o.hierarchical.validate();
   if (technique.models.size() == 1 && !args.model.empty() &&
       args.model != materials::to_string(technique.models.front())) {
     throw Error("--model: the " + technique.name + " technique " + technique.model_note +
                 ", got '" + args.model + "'; use --model " +
                 materials::to_string(technique.models.front()) + " or leave it out");
   }
-  if (args.sh_fresnel != "exact" && args.sh_fresnel != "schlick") {
-    throw Error("--sh-fresnel: expected exact or schlick, got '" + args.sh_fresnel + "'");
-  }
-  args.sh.schlick = args.sh_fresnel == "schlick";
-  args.sh.attenuation = render::parse_sh_attenuation(args.sh_attenuation);
-  args.sh.validate();
+  o.sh.validate();
   if (!(args.object_size_mm > 0) || !std::isfinite(args.object_size_mm)) {
     throw Error("--object-size-mm: must be positive");
   }
-  if (args.reference.surface_samples < 1) throw Error("--samples-reference: must be at least 1");
-  if (args.reference.passes < 1) throw Error("--passes: must be at least 1");
-  args.settings.disc_selection = parse_disc_selection(args.disc_selection);
-  args.settings.disc_distribution = parse_disc_distribution(args.disc_distribution);
-  if (args.reference_sampling == "probes") {
-    args.reference.sampling = ReferenceSampling::kProbes;
-  } else if (args.reference_sampling == "area") {
-    args.reference.sampling = ReferenceSampling::kArea;
-  } else {
-    throw Error("--reference-sampling: expected probes or area, got '" + args.reference_sampling +
-                "'");
-  }
-  if (args.reference.pixel_samples < 1) throw Error("--samples-pixel: must be at least 1");
-  if (args.max_blur < -1 || args.max_blur > 8) throw Error("--max-blur: must be -1..8");
-  args.settings.validate();
+  o.reference.validate();
+  o.maps.validate();
+  o.settings.validate();
   if (args.exposure == "auto") {
     args.auto_exposure = true;
-    args.settings.exposure = 1.0f;
+    o.settings.exposure = 1.0f;
   } else {
     const auto e = parse_numbers(args.exposure, "--exposure", 1, ',', "a positive number or auto");
     if (!(e[0] > 0 && e[0] <= 1e12))
       throw Error("--exposure: expected a scale in (0, 1e12] or auto, got '" + args.exposure + "'");
     args.auto_exposure = false;
-    args.settings.exposure = float(e[0]);
+    o.settings.exposure = float(e[0]);
   }
   if (!(args.roughness >= 0) || !(args.roughness <= 1)) {
     throw Error("--roughness: the GGX width must be 0..1, got " + std::to_string(args.roughness));
   }
-  for (const auto& [name, value] : {std::pair{"--irradiance-cache", &args.irradiance_cache},
-                                    std::pair{"--hbe-irradiance-cache", &args.hbe_irradiance_cache}}) {
-    if (*value != "on" && *value != "off") {
-      throw Error(std::string(name) + ": expected on or off, got '" + *value + "'");
-    }
-  }
-  args.reference.irradiance_cache = args.irradiance_cache == "on";
   if (args.fur_coat != "on" && args.fur_coat != "off") {
     throw Error("--fur-coat: expected on or off, got '" + args.fur_coat + "'");
   }
@@ -350,22 +201,20 @@ SceneSetup build_scene(SceneArguments& args) {
                   return t.fur_coat && t.id != render::TechniqueId::kFur;
                 }));
   }
-  if (args.fur_coverage != "exact" && args.fur_coverage != "seed") {
-    throw Error("--fur-coverage: expected exact or seed, got '" + args.fur_coverage + "'");
-  }
-  args.fur.coverage = args.fur_coverage == "seed" ? render::fur::CoverageRule::kSeed
-                                                  : render::fur::CoverageRule::kExact;
   if (args.technique_id == render::TechniqueId::kFur || args.fur_coat == "on") {
     // Hair counts follow the tile's area (the seed's density at 64 x 64 texels).
-    const double scale = double(args.fur.texels) * args.fur.texels / (64.0 * 64.0);
-    args.fur.overcoat.hairs = int(std::lround(600 * scale));
-    args.fur.undercoat.hairs = int(std::lround(2400 * scale));
-    args.fur.validate();
+    const double scale = double(o.fur.texels) * o.fur.texels / (64.0 * 64.0);
+    o.fur.overcoat.hairs = int(std::lround(600 * scale));
+    o.fur.undercoat.hairs = int(std::lround(2400 * scale));
+    o.fur.validate();
   }
-  args.hbe.irradiance_cache = args.hbe_irradiance_cache == "on";
   if (args.specular != "on" && args.specular != "off") {
     throw Error("--specular: expected on or off, got '" + args.specular + "'");
   }
+}
+
+render::Vec3f parse_backdrop(const SceneArguments& args) {
+  using render::Vec3f;
   Vec3f backdrop = Vec3f::Zero();
   if (!args.backdrop.empty()) {
     const auto b = parse_numbers(args.backdrop, "--backdrop", 3, ',', "R,G,B radiance >= 0");
@@ -374,16 +223,24 @@ SceneSetup build_scene(SceneArguments& args) {
     }
     backdrop = Vec3f(float(b[0]), float(b[1]), float(b[2]));
   }
+  return backdrop;
+}
+
+// --light (or, with neither --light nor --env, the default rig turned with the camera's azimuth),
+// and --env parsed into `env` (its lights are drawn once the map is loaded).
+std::vector<render::Light> parse_lights(SceneArguments& args, double azimuth_deg,
+                                        std::optional<EnvironmentArgument>& env) {
+  using render::Light;
+  using render::parse_light;
   std::vector<Light> lights;
   for (const auto& text : args.lights) lights.push_back(parse_light(text));
-  std::optional<EnvironmentArgument> env;
   if (!args.env.empty()) env = parse_environment_argument(args.env);
   args.default_rig.clear();
   if (lights.empty() && !env) {
     // The default rig, turned with the camera's azimuth so that it lights the object alike from
     // every --view: a key light above the camera's left, a dim fill from its right and a rim light
     // from behind (where a translucent object glows).
-    const double a = view[0] * std::numbers::pi / 180.0;
+    const double a = azimuth_deg * std::numbers::pi / 180.0;
     const auto turned = [a](double x, double y, double z) {
       char text[96];
       std::snprintf(text, sizeof text, "%.3g,%.3g,%.3g", std::cos(a) * x + std::sin(a) * z, y,
@@ -395,18 +252,34 @@ SceneSetup build_scene(SceneArguments& args) {
                         "directional:" + turned(0.3, 0.6, -1) + ":0.6,0.6,0.6"};
     for (const auto& text : args.default_rig) lights.push_back(parse_light(text));
   }
+  return lights;
+}
+
+}  // namespace
+
+SceneSetup build_scene(SceneArguments& args) {
+  using namespace lucent::render;
+  // Everything that needs no file first, so that typing errors fail before any loading.
+  const auto [size, view] = parse_camera(args);
+  args.technique_id = render::parse_technique(args.technique);
+  const render::TechniqueInfo& technique = render::technique_info(args.technique_id);
+  check_options(args, technique);
+  TechniqueOptions& o = args.options;
+  const Vec3f backdrop = parse_backdrop(args);
+  std::optional<EnvironmentArgument> env;
+  const std::vector<Light> lights = parse_lights(args, view[0], env);
 
   Scene scene;
   scene.material = materials::load_material(args.material);
-  args.settings.model = !args.model.empty()
-                            ? materials::parse_diffusion_model(args.model, "--model", true)
-                            : materials::preferred_model(scene.material);
-  if (technique.models.size() == 1) args.settings.model = technique.models.front();
+  o.settings.model = !args.model.empty()
+                         ? materials::parse_diffusion_model(args.model, "--model", true)
+                         : materials::preferred_model(scene.material);
+  if (technique.models.size() == 1) o.settings.model = technique.models.front();
   scene.mesh = load_mesh(args.mesh, args.object_size_mm);
   scene.lights = lights;
   if (env) {
     const EnvironmentMap map = load_environment(env->path);
-    const auto env_lights = environment_lights(map, env->lights, args.reference.seed);
+    const auto env_lights = environment_lights(map, env->lights, o.reference.seed);
     if (env_lights.empty() && lights.empty()) {
       throw Error("--env: " + env->path + " is black everywhere: no light");
     }
@@ -416,11 +289,12 @@ SceneSetup build_scene(SceneArguments& args) {
   scene.roughness = args.roughness;
   scene.specular = args.specular == "on";
   scene.backdrop = backdrop;
-  if (args.fur_coat == "on") scene.fur_coat = render::fur::make_fur_coat(render::fur::over_mesh(args.fur));
+  if (args.fur_coat == "on")
+    scene.fur_coat = render::fur::make_fur_coat(render::fur::over_mesh(o.fur));
   scene.camera = orbit_camera(scene.mesh, float(view[0]), float(view[1]), float(view[2]),
                               int(size[0]), int(size[1]));
+  if (args.on_valid) args.on_valid();
   return SceneSetup{std::move(scene), float(view[0]), float(view[1]), float(view[2])};
 }
-
 
 }  // namespace lucent::cli

@@ -3,6 +3,7 @@
 // that needs no file is validated first, so that typing errors fail before any loading.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -29,28 +30,19 @@ struct SceneArguments {
   std::string view = "30,20,3.4";  // 3.4 radii: the bounding sphere fits the 35-degree view
   std::string size;
   double object_size_mm = 100;
-  std::string disc_selection = "strata";
-  std::string disc_distribution = "profile";
-  std::string reference_sampling = "probes";
   std::string exposure = "auto";  ///< a number or auto (tone_map.h auto_exposure)
   bool auto_exposure = true;      ///< set by build_scene from `exposure`
   float roughness = 0.1f;
   std::string specular = "on";
-  std::string irradiance_cache = "off";  // --irradiance-cache on|off (reference)
-  std::string hbe_irradiance_cache = "on";  // --hbe-irradiance-cache on|off
-  std::string backdrop;           ///< R,G,B radiance; empty: black
-  int max_blur = -1;              ///< maps: RadianceMapOptions::max_blur_level (-1 automatic)
+  std::string backdrop;                  ///< R,G,B radiance; empty: black
   std::vector<std::string> default_rig;  ///< set by build_scene: the lights used when none given
-  render::RenderSettings settings;
-  render::ReferenceOptions reference;
-  render::ShOptions sh;            ///< --technique sh: shadow map, cube map, depth blur, Fresnel
-  std::string sh_fresnel = "exact";  ///< exact | schlick
-  std::string sh_attenuation = "slab";  ///< seed | normalised | slab
-  render::hbe::Options hbe;        ///< --technique hierarchical: oracle, form factor, mode
-  render::fur::FurOptions fur;     ///< --technique fur: the tile; --fur-coat: the coat's hairs
+  /// Every technique's options, filled by their flag groups (technique_flags.h); --seed writes
+  /// options.reference.seed, build_scene the model and the exposure into options.settings.
+  render::TechniqueOptions options;
   std::string fur_coat = "off";    ///< --fur-coat on|off: a fur coat over the skin (fur_coat.h)
-  std::string fur_coverage = "exact";  ///< --fur-coverage exact|seed: the hairs' cross-sections
-  std::string hbe_mode = "render", hbe_rule = "gauss2", hbe_dipole = "chord";
+  /// Called by build_scene once everything is validated and loaded: the deprecation line of the
+  /// earlier spellings (technique_flags.h), so that a refusal stays one line.
+  std::function<void()> on_valid;
 };
 
 /// Adds the shared options to `cmd`; `size_help` says what --size is (image or window).

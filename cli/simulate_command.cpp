@@ -224,29 +224,25 @@ void run(SimulateArguments& args) {
   if (args.json) std::cout << (all.size() == 1 ? all[0] : all).dump(2) << '\n';
 }
 
-}  // namespace
+// Options of `lucent simulate`, added in the help's order, one group per concern.
 
-void register_simulate_command(CLI::App& app) {
-  auto args = std::make_shared<SimulateArguments>();
-  auto& o = args->options;
-  CLI::App* cmd = app.add_subcommand(
-      "simulate",
-      "Virtual capture rig: Monte Carlo photon transport in a slab (Henyey-Greenstein phase, "
-      "Fresnel boundary) lit by a pencil beam of unit power, imaged by a camera model into "
-      "exposure "
-      "brackets with a white reference and a dark frame. Writes OUTDIR/capture.json for lucent "
-      "acquire, the bracket PNGs, truth.json and truth_radiance.exr (mm^-2 sr^-1 per unit power).");
-  cmd->add_option("--material", args->material, "bundled material name or material file")
+// What is simulated and where it goes: the material, the output folder and the radiance source.
+void add_subject_options(CLI::App* cmd, SimulateArguments& args) {
+  cmd->add_option("--material", args.material, "bundled material name or material file")
       ->required();
-  cmd->add_option("-o,--output", args->output,
+  cmd->add_option("-o,--output", args.output,
                   "output folder (created whole; an existing one is refused unless --force)")
       ->required();
-  cmd->add_flag("--force", args->force,
+  cmd->add_flag("--force", args.force,
                 "replace an existing output folder whole (its other files are removed)");
-  cmd->add_option("--source", args->source,
+  cmd->add_option("--source", args.source,
                   "exit radiance from montecarlo (photon transport), or from the dipole / ddipole "
                   "model (for round trips of lucent fit)")
       ->capture_default_str();
+}
+
+// Photon transport: photons, seed, threads, the slab and the beam's width.
+void add_transport_options(CLI::App* cmd, acquire::SimulateOptions& o) {
   cmd->add_option("--photons", o.transport.photons, "photons per colour channel")
       ->check(whole_in(100, 1000000000000000ull, "photons per channel"))
       ->capture_default_str();
@@ -263,6 +259,10 @@ void register_simulate_command(CLI::App& app) {
                   "beam); the white reference is lit by the same beam")
       ->check(number_in(0, 100, "mm"))
       ->capture_default_str();
+}
+
+// The lens: its blur and veiling glare.
+void add_lens_options(CLI::App* cmd, acquire::SimulateOptions& o) {
   cmd->add_option("--lens-blur-mm", o.lens_blur_mm,
                   "lens blur: Gaussian sigma on the sample, mm (sample and white reference)")
       ->check(number_in(0, 100, "mm"))
@@ -276,7 +276,12 @@ void register_simulate_command(CLI::App& app) {
                   "core radius a of the glare kernel a / (2 pi (r^2 + a^2)^1.5), mm")
       ->check(number_in(1e-3, 1000, "mm"))
       ->capture_default_str();
-  cmd->add_option("--side", args->side,
+}
+
+// The rig's geometry: the side seen, the beam's and the camera's angles.
+void add_geometry_options(CLI::App* cmd, SimulateArguments& args) {
+  acquire::SimulateOptions& o = args.options;
+  cmd->add_option("--side", args.side,
                   "which side the camera sees: reflected (the lit side), transmitted (a slab's "
                   "far side, the camera below; needs --thickness-mm) or both (OUTDIR/reflected "
                   "and OUTDIR/transmitted, one capture each, the same photons)")
@@ -295,25 +300,43 @@ void register_simulate_command(CLI::App& app) {
                   "camera azimuth, degrees from +x")
       ->check(number_in(-360, 360, "degrees"))
       ->capture_default_str();
-  CLI::Option* size = cmd->add_option(
-      "--size", o.transport.size,
-      "image width and height, pixels (default: the field holds 3.5 diffusion lengths of the "
-      "slowest channel each side of the beam, at most 1024 pixels)")
-      ->check(whole_in(1, 16384, "an image size in pixels"));
-  CLI::Option* pixel = cmd->add_option(
-      "--pixel-mm", o.transport.pixel_mm,
-      "pixel pitch on the sample, mm (default: a quarter of the shortest transport mean free "
-      "path, 0.02..0.1 mm, coarser when the field would pass 1024 pixels)")
-      ->check(number_in(0, 100, "mm", true));
+}
+
+// --size and --pixel-mm: whether each was given decides the default field.
+struct FieldOptions {
+  CLI::Option* size = nullptr;
+  CLI::Option* pixel = nullptr;
+};
+
+// The field imaged: its size, pixel pitch and the radial table's extent.
+FieldOptions add_field_options(CLI::App* cmd, acquire::SimulateOptions& o) {
+  FieldOptions field;
+  field.size = cmd->add_option("--size", o.transport.size,
+                               "image width and height, pixels (default: the field holds 3.5 "
+                               "diffusion lengths of the slowest channel each side of the beam, "
+                               "at most 1024 pixels)")
+                   ->check(whole_in(1, 16384, "an image size in pixels"));
+  field.pixel =
+      cmd->add_option("--pixel-mm", o.transport.pixel_mm,
+                      "pixel pitch on the sample, mm (default: a quarter of the shortest transport "
+                      "mean free path, 0.02..0.1 mm, coarser when the field would pass 1024 "
+                      "pixels)")
+          ->check(number_in(0, 100, "mm", true));
   cmd->add_option("--max-radius-mm", o.transport.max_radius_mm,
                   "outer radius of the radial exitance table, mm")
       ->check(number_in(0, 1e6, "mm", true))
       ->capture_default_str();
-  cmd->add_option("--exposures", args->exposures, "exposure times in s, increasing")
+  return field;
+}
+
+// The camera: exposures, encoding, sensor and the extra frames it takes.
+void add_camera_options(CLI::App* cmd, SimulateArguments& args) {
+  acquire::SimulateOptions& o = args.options;
+  cmd->add_option("--exposures", args.exposures, "exposure times in s, increasing")
       ->capture_default_str();
-  cmd->add_option("--response", args->response,
+  cmd->add_option("--response", args.response,
                   "camera encoding: srgb or linear (default: srgb for PNG, linear for DNG)");
-  cmd->add_option("--bracket-format", args->bracket_format,
+  cmd->add_option("--bracket-format", args.bracket_format,
                   "bracket files: png (the camera's encoding) or dng (a Bayer sensor's linear "
                   "RAW codes with black level, exposure time and ISO in each file)")
       ->capture_default_str();
@@ -334,16 +357,41 @@ void register_simulate_command(CLI::App& app) {
                   "shortest exposure")
       ->check(number_in(0, 1e30, "electrons per (radiance s); 0: automatic"))
       ->capture_default_str();
-  cmd->add_flag("--no-noise", args->no_noise, "noise-free camera (exact expected values)");
-  cmd->add_flag("--no-white-reference", args->no_white, "do not image the white reference");
-  cmd->add_flag("--no-dark", args->no_dark, "do not take a dark frame");
-  cmd->add_flag("--profile-only", o.profile_only, "transport only: no images, no capture.json");
-  cmd->add_option("--exitance-csv", args->exitance_csv,
+  cmd->add_flag("--no-noise", args.no_noise, "noise-free camera (exact expected values)");
+  cmd->add_flag("--no-white-reference", args.no_white, "do not image the white reference");
+  cmd->add_flag("--no-dark", args.no_dark, "do not take a dark frame");
+}
+
+// What is written and said: transport only, the exitance CSV, JSON or quiet.
+void add_report_options(CLI::App* cmd, SimulateArguments& args) {
+  cmd->add_flag("--profile-only", args.options.profile_only,
+                "transport only: no images, no capture.json");
+  cmd->add_option("--exitance-csv", args.exitance_csv,
                   "also write the radial exitance R(r) (mm^-2 per unit power) and totals as CSV "
                   "(--side both: FILE-reflected.csv and FILE-transmitted.csv)");
-  cmd->add_flag("--json", args->json, "print a JSON summary on stdout");
-  cmd->add_flag("-q,--quiet", args->quiet, "no progress or summary");
-  cmd->callback([args, size, pixel] {
+  cmd->add_flag("--json", args.json, "print a JSON summary on stdout");
+  cmd->add_flag("-q,--quiet", args.quiet, "no progress or summary");
+}
+
+}  // namespace
+
+void register_simulate_command(CLI::App& app) {
+  auto args = std::make_shared<SimulateArguments>();
+  CLI::App* cmd = app.add_subcommand(
+      "simulate",
+      "Virtual capture rig: Monte Carlo photon transport in a slab (Henyey-Greenstein phase, "
+      "Fresnel boundary) lit by a pencil beam of unit power, imaged by a camera model into "
+      "exposure "
+      "brackets with a white reference and a dark frame. Writes OUTDIR/capture.json for lucent "
+      "acquire, the bracket PNGs, truth.json and truth_radiance.exr (mm^-2 sr^-1 per unit power).");
+  add_subject_options(cmd, *args);
+  add_transport_options(cmd, args->options);
+  add_lens_options(cmd, args->options);
+  add_geometry_options(cmd, *args);
+  const FieldOptions field = add_field_options(cmd, args->options);
+  add_camera_options(cmd, *args);
+  add_report_options(cmd, *args);
+  cmd->callback([args, size = field.size, pixel = field.pixel] {
     args->size_given = size->count() > 0;
     args->pixel_given = pixel->count() > 0;
     set_replace_folders(args->force);

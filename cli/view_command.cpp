@@ -41,15 +41,16 @@ void run_view(ViewArguments& args) {
   render::ViewerOptions options;
   options.scene = std::move(setup.scene);
   options.material_source = args.scene.material;
-  options.settings = args.scene.settings;
+  const render::TechniqueOptions& flags = args.scene.options;
+  options.settings = flags.settings;
   options.model_follows_material = !model_given;
-  options.reference = args.scene.reference;
+  options.reference = flags.reference;
   options.view = {setup.azimuth_deg, setup.elevation_deg, setup.distance_radii};
   options.object_size_mm = args.scene.object_size_mm;
   options.technique = args.scene.technique_id;
-  options.sh = args.scene.sh;
-  options.hbe = args.scene.hbe;
-  options.fur = args.scene.fur;
+  options.sh = flags.sh;
+  options.hierarchical = flags.hierarchical;
+  options.fur = flags.fur;
   options.deform_amplitude = args.deform;
   options.script = args.script;
   options.hide_panel = args.hide_panel;
@@ -88,8 +89,8 @@ void register_view_command(CLI::App& app) {
       "deformer.");
   // The reference in the window runs pass after pass at half the window's resolution: fewer
   // samples per pass than `lucent render`'s default keep the first picture quick.
-  args->scene.reference.surface_samples = 20000;
-  args->scene.reference.pixel_samples = 64;
+  args->scene.options.reference.surface_samples = 20000;
+  args->scene.options.reference.pixel_samples = 64;
   args->scene.size = "960x720";
   add_scene_options(cmd, args->scene, "window size WxH in pixels");
   cmd->add_option("--deform", args->deform,

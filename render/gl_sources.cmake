@@ -62,11 +62,16 @@ foreach(dir IN LISTS LUCENT_SHADER_DIRS)
   list(APPEND LUCENT_SHADER_FILES ${files})
 endforeach()
 set(LUCENT_SHADER_CPP "${CMAKE_CURRENT_BINARY_DIR}/generated/gl_shader_sources.cpp")
+# The list of shader files, rewritten only when it changes: a shader renamed or added keeps its old
+# time stamp, so without this the embedded set would not follow the rename.
+set(LUCENT_SHADER_LIST "${CMAKE_CURRENT_BINARY_DIR}/generated/shader_files.txt")
+string(JOIN "\n" shader_list_text ${LUCENT_SHADER_FILES})
+file(CONFIGURE OUTPUT "${LUCENT_SHADER_LIST}" CONTENT "${shader_list_text}\n")
 add_custom_command(
   OUTPUT "${LUCENT_SHADER_CPP}"
   COMMAND "${CMAKE_COMMAND}" "-DSHADER_DIRS=${shader_dirs_joined}" "-DOUTPUT=${LUCENT_SHADER_CPP}"
           -P "${LUCENT_GL_DIR}/gl_sources.cmake"
-  DEPENDS ${LUCENT_SHADER_FILES} "${LUCENT_GL_DIR}/gl_sources.cmake"
+  DEPENDS ${LUCENT_SHADER_FILES} "${LUCENT_SHADER_LIST}" "${LUCENT_GL_DIR}/gl_sources.cmake"
   COMMENT "Embedding the shaders (render/gl/shaders, render/techniques/*/shaders) into gl_shader_sources.cpp"
   VERBATIM)
 

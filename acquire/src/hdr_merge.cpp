@@ -7,12 +7,19 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/photo.hpp>
 
+#include "hdr_merge_impl.h"
 #include "lucent/acquire/camera.h"
 #include "lucent/core/error.h"
 #include "lucent/imaging/image_io.h"
 
 namespace lucent::acquire {
 namespace {
+
+using detail::fit_neighbour_noise;
+using detail::fit_variance_model;
+using detail::NoiseRow;
+using detail::quantisation_variance;
+using detail::Stack;
 
 namespace fs = std::filesystem;
 
@@ -28,9 +35,6 @@ constexpr double kHighRamp = 0.02;
 // brought them within 3% for about 0.5 s more (the solve does not grow with the image).
 constexpr int kDebevecSamples = 200;
 constexpr float kDebevecSmoothing = 10.0f;
-
-// Median of a chi-square variable with one degree of freedom: median(e^2) = 0.45494 sigma^2.
-constexpr double kChiSquare1Median = 0.454936423119572;
 
 fs::path resolve(const fs::path& base_dir, const fs::path& path) {
   return path.is_absolute() || base_dir.empty() ? path : base_dir / path;
@@ -55,75 +59,6 @@ double taper(int v, int max_value) {
   if (v <= 0 || v >= top) return 0.0;
   return std::min({1.0, v / (kLowRamp * top), (top - v) / (kHighRamp * top)});
 }
-
-// Quantisation variance of each code in linear units: the curve's local step squared over 12.
-std::array<std::vector<double>, 3> quantisation_variance(const ResponseCurve& curve) {
-  std::array<std::vector<double>, 3> q2;
-  const int m = curve.max_value;
-  for (int c = 0; c < 3; ++c) {
-    const std::vector<double>& f = curve.linear[c];
-    q2[c].resize(std::size_t(m) + 1);
-    for (int v = 0; v <= m; ++v) {
-      const int lo = std::max(v - 1, 0), hi = std::min(v + 1, m);
-      const double step = (f[hi] - f[lo]) / (hi - lo);
-      q2[c][v] = step * step / 12.0;
-    }
-  }
-  return q2;
-}
-
-// Non-negative least squares for y ~ p A + q B with weights w (2 parameters, closed form on each
-// face of the constraint set). Returns {p, q}.
-struct Row {
-  double a, b, y, w;
-};
-
-std::array<double, 2> fit_non_negative(const std::vector<Row>& rows) {
-  double saa = 0, sab = 0, sbb = 0, say = 0, sby = 0;
-  for (const Row& r : rows) {
-    saa += r.w * r.a * r.a;
-    sab += r.w * r.a * r.b;
-    sbb += r.w * r.b * r.b;
-    say += r.w * r.a * r.y;
-    sby += r.w * r.b * r.y;
-  }
-  const auto cost = [&](double p, double q) {
-    return p * p * saa + q * q * sbb + 2 * p * q * sab - 2 * p * say - 2 * q * sby;
-  };
-  std::array<double, 2> best{0.0, 0.0};
-  double best_cost = 0.0;  // cost(0, 0)
-  const double det = saa * sbb - sab * sab;
-  if (det > 1e-12 * saa * sbb && saa > 0 && sbb > 0) {
-    const double p = (say * sbb - sby * sab) / det, q = (sby * saa - say * sab) / det;
-    if (p >= 0 && q >= 0 && cost(p, q) < best_cost) best = {p, q}, best_cost = cost(p, q);
-  }
-  if (saa > 0 && say > 0 && cost(say / saa, 0) < best_cost) {
-    best = {say / saa, 0.0}, best_cost = cost(say / saa, 0);
-  }
-  if (sbb > 0 && sby > 0 && cost(0, sby / sbb) < best_cost) best = {0.0, sby / sbb};
-  return best;
-}
-
-// Reweighted fit: Var(d^2) = 2 E[d^2]^2 for a Gaussian difference, so each row is weighted by the
-// inverse square of its predicted E[d^2] (= p a + q b + floor), starting from unit weights.
-std::array<double, 2> fit_variance_model(std::vector<Row>& rows, const std::vector<double>& floor) {
-  std::array<double, 2> pq = fit_non_negative(rows);
-  for (int iteration = 0; iteration < 6; ++iteration) {
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-      const double predicted = pq[0] * rows[i].a + pq[1] * rows[i].b + floor[i];
-      rows[i].w = predicted > 0 ? 1.0 / (predicted * predicted) : 0.0;
-    }
-    pq = fit_non_negative(rows);
-  }
-  return pq;
-}
-
-struct Stack {
-  std::vector<imaging::RawImage> images;
-  std::vector<double> exposure_s;  ///< effective: the time, times ISO / 100 where the ISO is known
-  std::vector<fs::path> paths;
-  bool iso_known = false;
-};
 
 bool is_camera_raw(const imaging::RawImage& image) {
   return image.black != std::array<double, 3>{0.0, 0.0, 0.0} ||
@@ -245,56 +180,6 @@ void require_usable_pixels(const HdrResult& result, const std::string& sources) 
               " black, " + std::to_string(m.non_finite[c]) + " non-finite)");
 }
 
-// The fallback noise model var(L) = a L + b from each pixel's spread around the mean of its four
-// neighbours (Var(L0 - mean4) = 1.25 sigma^2 for independent noise of similar size), per channel:
-// medians of the squared spread in 32 brightness groups (robust against edges), then a weighted
-// non-negative fit. Fills result.noise.
-void fit_neighbour_noise(HdrResult& result) {
-  const imaging::ImageRgb& image = result.radiance;
-  const int w = image.width, h = image.height;
-  result.noise = {};
-  result.noise.source = "neighbours";
-  for (int c = 0; c < 3; ++c) {
-    std::vector<std::pair<double, double>> samples;  // (L, spread^2 / 1.25)
-    for (int y = 1; y + 1 < h; ++y) {
-      for (int x = 1; x + 1 < w; ++x) {
-        if (!result.valid(x, y, c) || !result.valid(x - 1, y, c) || !result.valid(x + 1, y, c) ||
-            !result.valid(x, y - 1, c) || !result.valid(x, y + 1, c)) {
-          continue;
-        }
-        const double mean4 = 0.25 * (double(image.at(x - 1, y, c)) + image.at(x + 1, y, c) +
-                                     image.at(x, y - 1, c) + image.at(x, y + 1, c));
-        const double spread = image.at(x, y, c) - mean4;
-        samples.emplace_back(image.at(x, y, c), spread * spread / 1.25);
-      }
-    }
-    result.noise.samples += std::int64_t(samples.size());
-    if (samples.size() < 64) continue;  // too few to say anything: the model stays 0
-    std::sort(samples.begin(), samples.end());
-    const std::size_t groups = std::min<std::size_t>(32, samples.size() / 32);
-    std::vector<Row> rows;
-    std::vector<double> floor;
-    for (std::size_t g = 0; g < groups; ++g) {
-      const std::size_t begin = samples.size() * g / groups,
-                        end = samples.size() * (g + 1) / groups;
-      std::vector<double> spreads;
-      double mean_l = 0;
-      for (std::size_t i = begin; i < end; ++i) {
-        spreads.push_back(samples[i].second);
-        mean_l += samples[i].first;
-      }
-      mean_l /= double(end - begin);
-      std::nth_element(spreads.begin(), spreads.begin() + spreads.size() / 2, spreads.end());
-      const double variance = spreads[spreads.size() / 2] / kChiSquare1Median;
-      rows.push_back({std::max(mean_l, 0.0), 1.0, variance, 1.0});
-      floor.push_back(0.0);
-    }
-    const auto [a, b] = fit_variance_model(rows, floor);
-    result.noise.gain[c] = a;
-    result.noise.read_variance[c] = b;
-  }
-}
-
 HdrResult read_hdr(const ImageSet& set, const std::optional<fs::path>& dark,
                    const fs::path& base_dir) {
   HdrResult result;
@@ -345,26 +230,38 @@ HdrResult read_hdr(const ImageSet& set, const std::optional<fs::path>& dark,
   return result;
 }
 
-HdrResult merge_stack(const Stack& stack, const ResponseCurve& curve,
-                      const std::optional<imaging::RawImage>& dark) {
-  const imaging::RawImage& first = stack.images.front();
-  const int w = first.width, h = first.height, m = first.max_value;
-  const std::size_t n = first.data.size(), brackets = stack.images.size();
-  const int top = m - 1;
+// What every stage of merge_stack reads: the stack, its curve, the dark frame, and the tables
+// derived from them once (the weight ramp h(v), each code's quantisation variance).
+struct MergeInputs {
+  const Stack& stack;
+  const ResponseCurve& curve;
+  const std::optional<imaging::RawImage>& dark;
+  int w, h, m, top;
+  std::size_t n, brackets;
+  std::vector<double> ramp;
+  std::array<std::vector<double>, 3> q2;
 
-  std::vector<double> ramp(std::size_t(m) + 1);
-  for (int v = 0; v <= m; ++v) ramp[v] = taper(v, m);
-  const auto q2 = quantisation_variance(curve);
+  MergeInputs(const Stack& s, const ResponseCurve& c, const std::optional<imaging::RawImage>& d)
+      : stack(s), curve(c), dark(d) {
+    const imaging::RawImage& first = s.images.front();
+    w = first.width, h = first.height, m = first.max_value, top = m - 1;
+    n = first.data.size(), brackets = s.images.size();
+    ramp.resize(std::size_t(m) + 1);
+    for (int v = 0; v <= m; ++v) ramp[std::size_t(v)] = taper(v, m);
+    q2 = quantisation_variance(c);
+  }
 
-  HdrResult result;
-  result.radiance = imaging::ImageRgb(w, h, 0.0f);
-  result.standard_error = imaging::ImageRgb(w, h, 0.0f);
-  result.mask.assign(n, PixelMask::kValid);
-  result.sources = stack.paths;
-  result.sources_text = describe_sources(stack.paths);
-  result.response = curve;
+  // The stages, in order (each reads the tables above).
+  std::vector<double> mask_and_first_pass(HdrResult& result) const;
+  bool fit_bracket_noise(const std::vector<double>& first_pass, HdrResult& result) const;
+  std::vector<double> smoothed_first_pass(const HdrResult& result,
+                                          const std::vector<double>& first_pass) const;
+  void final_merge(const std::vector<double>& smooth_pass, bool from_pairs,
+                   HdrResult& result) const;
+};
 
-  // Masks, and a first merge with the shot-noise weights h t_k.
+// Stage 1: each pixel's mask and counts, and a first merge with the shot-noise weights h t_k.
+std::vector<double> MergeInputs::mask_and_first_pass(HdrResult& result) const {
   std::vector<double> first_pass(n, 0.0);
   for (std::size_t i = 0; i < n; ++i) {
     const int c = int(i % 3);
@@ -401,12 +298,18 @@ HdrResult merge_stack(const Stack& stack, const ResponseCurve& curve,
     if (mask == PixelMask::kValid) first_pass[i] = sum_wx / sum_w;
   }
   require_usable_pixels(result, result.sources_text);
+  return first_pass;
+}
 
+// Stage 2: the noise model from consecutive usable brackets. Returns whether there were enough
+// pairs (kMinNoisePairs) to fit it.
+bool MergeInputs::fit_bracket_noise(const std::vector<double>& first_pass,
+                                    HdrResult& result) const {
   // Noise model from consecutive usable brackets: d = x_k - x_k', E[d^2] = g A + s B + Q. Two
   // parameters need no more than ~1e5 pixels: larger images are subsampled on a regular stride.
   constexpr std::size_t kNoisePixels = 100000;
   const std::size_t stride = std::max<std::size_t>(1, (n / 3) / kNoisePixels);
-  std::array<std::vector<Row>, 3> rows;
+  std::array<std::vector<NoiseRow>, 3> rows;
   std::array<std::vector<double>, 3> floors;
   for (std::size_t i = 0; i < n; ++i) {
     if (result.mask[i] != PixelMask::kValid || (i / 3) % stride != 0) continue;
@@ -444,14 +347,13 @@ HdrResult merge_stack(const Stack& stack, const ResponseCurve& curve,
       result.noise.samples += std::int64_t(rows[c].size());
     }
   }
+  return from_pairs;
+}
 
-  // Final merge with inverse-variance weights (or the first pass, when the model is unknown), and
-  // the propagated standard error. The dark frame is shared by all brackets: its noise enters the
-  // merged value once, through sum_k w_k / t_k.
-  // Quantisation never vanishes for a real curve; the floor (1e-7 of full scale, squared) guards a
-  // flat stretch of a recovered (Debevec) curve with no fitted noise against infinite weights.
-  // The first pass averaged over 5 x 5 pixels (valid ones only): the signal the final weights
-  // come from.
+// Stage 3: the first pass averaged over 5 x 5 pixels (valid ones only): the signal the final
+// weights come from.
+std::vector<double> MergeInputs::smoothed_first_pass(const HdrResult& result,
+                                                     const std::vector<double>& first_pass) const {
   std::vector<double> smooth_pass(n, 0.0);
   {
     std::vector<double> valid(n, 0.0), value(n, 0.0);
@@ -465,6 +367,16 @@ HdrResult merge_stack(const Stack& stack, const ResponseCurve& curve,
     const double* b = ms.ptr<double>();
     for (std::size_t i = 0; i < n; ++i) smooth_pass[i] = b[i] > 0 ? a[i] / b[i] : first_pass[i];
   }
+  return smooth_pass;
+}
+
+// Stage 4: the final merge with inverse-variance weights (or the first pass, when the model is
+// unknown), and the propagated standard error. The dark frame is shared by all brackets: its noise
+// enters the merged value once, through sum_k w_k / t_k. Quantisation never vanishes for a real
+// curve; the floor (1e-7 of full scale, squared) guards a flat stretch of a recovered (Debevec)
+// curve with no fitted noise against infinite weights.
+void MergeInputs::final_merge(const std::vector<double>& smooth_pass, bool from_pairs,
+                              HdrResult& result) const {
   std::array<double, 3> variance_floor{};
   for (int c = 0; c < 3; ++c)
     variance_floor[c] = std::pow(1e-7 * std::abs(curve.linear[c][m]), 2) + 1e-300;
@@ -518,6 +430,21 @@ HdrResult merge_stack(const Stack& stack, const ResponseCurve& curve,
           float(std::sqrt(std::max(variance, double(quantisation_only[i]))));
     }
   }
+}
+
+HdrResult merge_stack(const Stack& stack, const ResponseCurve& curve,
+                      const std::optional<imaging::RawImage>& dark) {
+  const MergeInputs in(stack, curve, dark);
+  HdrResult result;
+  result.radiance = imaging::ImageRgb(in.w, in.h, 0.0f);
+  result.standard_error = imaging::ImageRgb(in.w, in.h, 0.0f);
+  result.mask.assign(in.n, PixelMask::kValid);
+  result.sources = stack.paths;
+  result.sources_text = describe_sources(stack.paths);
+  result.response = curve;
+  const std::vector<double> first_pass = in.mask_and_first_pass(result);
+  const bool from_pairs = in.fit_bracket_noise(first_pass, result);
+  in.final_merge(in.smoothed_first_pass(result, first_pass), from_pairs, result);
   return result;
 }
 

@@ -187,18 +187,10 @@ std::string format_number(double value) {
   return buffer;
 }
 
-}  // namespace
+// Stages of profile_from_json, in the order of the file's fields.
 
-std::string Profile::units() const {
-  return calibrated ? kCalibratedUnits : kRelativeUnits;
-}
-
-json profile_to_json(const Profile& profile) {
-  return json::parse(profile_to_ordered_json(profile).dump());
-}
-
-Profile profile_from_json(const json& doc, const std::string& source) {
-  const FieldReader in(source);
+// The file is a lucent-profile object of this version with no field we do not know.
+void check_profile_format(const FieldReader& in, const json& doc, const std::string& source) {
   if (!doc.is_object()) throw Error(source + ": expected a JSON object (a lucent-profile file)");
   in.only_known(doc, "",
                 {"format", "version", "calibrated", "units", "capture", "pixel_pitch_mm",
@@ -216,7 +208,10 @@ Profile profile_from_json(const json& doc, const std::string& source) {
             "this lucent reads profile version 1, found " +
                 (doc.contains("version") ? doc["version"].dump() : std::string("nothing")));
   }
-  Profile p;
+}
+
+// Whether the values are calibrated, the units that says they are in, and the capture file.
+void read_calibration(const FieldReader& in, const json& doc, Profile& p) {
   const json& calibrated = in.get(doc, "calibrated", "calibrated");
   if (!calibrated.is_boolean()) in.fail("calibrated", "expected true or false");
   p.calibrated = calibrated.get<bool>();
@@ -228,6 +223,10 @@ Profile profile_from_json(const json& doc, const std::string& source) {
   const json& capture = in.get(doc, "capture", "capture");
   if (!capture.is_string()) in.fail("capture", "expected a string (the capture file)");
   p.capture = capture.get<std::string>();
+}
+
+// The geometry: pixel pitch, incidence, view, relative index and slab.
+void read_geometry(const FieldReader& in, const json& doc, const std::string& source, Profile& p) {
   p.pixel_pitch_mm = in.number(in.get(doc, "pixel_pitch_mm", "pixel_pitch_mm"), "pixel_pitch_mm");
   if (!(p.pixel_pitch_mm >= 1e-6 && p.pixel_pitch_mm <= 100))
     in.fail("pixel_pitch_mm", "expected a pixel pitch in [1e-6, 100] mm");
@@ -244,24 +243,28 @@ Profile profile_from_json(const json& doc, const std::string& source) {
     if (!(*p.ior >= 0.25 && *p.ior <= 4)) in.fail("ior", "expected a relative index in [0.25, 4]");
   }
   detail::read_slab_fields(doc, source, p.thickness_mm, p.transmitted);
-  if (doc.contains("system_response")) {
-    const json& s = doc["system_response"];
-    if (!s.is_object()) in.fail("system_response", "expected an object");
-    in.only_known(s, "system_response.", {"r_mm", "value", "rms_radius_mm", "units", "source"});
-    const json& r = in.get(s, "r_mm", "system_response.r_mm");
-    if (!r.is_array() || r.size() < 2 || r.size() > 100000)
-      in.fail("system_response.r_mm", "expected 2..100000 radii");
-    p.response_r_mm = in.numbers(r, "system_response.r_mm", r.size());
-    p.response_value =
-        in.numbers(in.get(s, "value", "system_response.value"), "system_response.value", r.size());
-    p.response_rms_mm =
-        in.number(in.get(s, "rms_radius_mm", "system_response.rms_radius_mm"),
-                  "system_response.rms_radius_mm");
-    for (std::size_t i = 0; i < p.response_r_mm.size(); ++i)
-      if (!(p.response_r_mm[i] >= 0) || (i > 0 && !(p.response_r_mm[i] > p.response_r_mm[i - 1])))
-        in.fail("system_response.r_mm", "expected radii >= 0 mm, rising");
-    if (!(p.response_rms_mm >= 0)) in.fail("system_response.rms_radius_mm", "expected >= 0 mm");
-  }
+}
+
+// The optional system response `s` measured on the white reference.
+void read_system_response(const FieldReader& in, const json& s, Profile& p) {
+  if (!s.is_object()) in.fail("system_response", "expected an object");
+  in.only_known(s, "system_response.", {"r_mm", "value", "rms_radius_mm", "units", "source"});
+  const json& r = in.get(s, "r_mm", "system_response.r_mm");
+  if (!r.is_array() || r.size() < 2 || r.size() > 100000)
+    in.fail("system_response.r_mm", "expected 2..100000 radii");
+  p.response_r_mm = in.numbers(r, "system_response.r_mm", r.size());
+  p.response_value =
+      in.numbers(in.get(s, "value", "system_response.value"), "system_response.value", r.size());
+  p.response_rms_mm = in.number(in.get(s, "rms_radius_mm", "system_response.rms_radius_mm"),
+                                "system_response.rms_radius_mm");
+  for (std::size_t i = 0; i < p.response_r_mm.size(); ++i)
+    if (!(p.response_r_mm[i] >= 0) || (i > 0 && !(p.response_r_mm[i] > p.response_r_mm[i - 1])))
+      in.fail("system_response.r_mm", "expected radii >= 0 mm, rising");
+  if (!(p.response_rms_mm >= 0)) in.fail("system_response.rms_radius_mm", "expected >= 0 mm");
+}
+
+// The beam: its entry point, how that was found, and its power (needed when calibrated).
+void read_beam(const FieldReader& in, const json& doc, Profile& p) {
   const auto point = in.numbers(in.get(doc, "beam_point_px", "beam_point_px"), "beam_point_px", 2);
   p.beam_point_px = {point[0], point[1]};
   const json& point_source = in.get(doc, "beam_point_source", "beam_point_source");
@@ -281,12 +284,13 @@ Profile profile_from_json(const json& doc, const std::string& source) {
   }
   if (p.calibrated && !p.beam_power)
     in.fail("beam_power", "a calibrated profile needs the beam power");
+}
 
-  const json& radial = in.get(doc, "radial", "radial");
+// The radial profile: bins of equal length in every array, each with 0 <= r_inner < r_outer.
+void read_radial(const FieldReader& in, const json& radial, RadialProfile& r) {
   if (!radial.is_object()) in.fail("radial", "expected an object");
   in.only_known(radial, "radial.",
                 {"r_mm", "r_inner_mm", "r_outer_mm", "value", "standard_error", "count"});
-  RadialProfile& r = p.radial;
   r.r_mm = in.numbers(in.get(radial, "r_mm", "radial.r_mm"), "radial.r_mm");
   const std::size_t bins = r.r_mm.size();
   r.r_inner_mm =
@@ -307,22 +311,24 @@ Profile profile_from_json(const json& doc, const std::string& source) {
       in.fail("radial.r_inner_mm[" + std::to_string(i) + "]", "expected 0 <= r_inner < r_outer");
     }
   }
+}
 
-  if (doc.contains("samples_2d")) {
-    const json& s2 = doc["samples_2d"];
-    if (!s2.is_object()) in.fail("samples_2d", "expected an object");
-    in.only_known(s2, "samples_2d.", {"x_mm", "y_mm", "value", "standard_error"});
-    Samples2d s;
-    s.x_mm = in.numbers(in.get(s2, "x_mm", "samples_2d.x_mm"), "samples_2d.x_mm");
-    s.y_mm = in.numbers(in.get(s2, "y_mm", "samples_2d.y_mm"), "samples_2d.y_mm", s.x_mm.size());
-    s.value = in.channels(in.get(s2, "value", "samples_2d.value"), "samples_2d.value",
-                          s.x_mm.size(), "sample");
-    s.standard_error = in.channels(in.get(s2, "standard_error", "samples_2d.standard_error"),
-                                   "samples_2d.standard_error", s.x_mm.size(), "sample");
-    p.samples_2d = std::move(s);
-  }
+// The optional 2D samples `s2`: one position and one value per channel per sample.
+Samples2d read_samples_2d(const FieldReader& in, const json& s2) {
+  if (!s2.is_object()) in.fail("samples_2d", "expected an object");
+  in.only_known(s2, "samples_2d.", {"x_mm", "y_mm", "value", "standard_error"});
+  Samples2d s;
+  s.x_mm = in.numbers(in.get(s2, "x_mm", "samples_2d.x_mm"), "samples_2d.x_mm");
+  s.y_mm = in.numbers(in.get(s2, "y_mm", "samples_2d.y_mm"), "samples_2d.y_mm", s.x_mm.size());
+  s.value = in.channels(in.get(s2, "value", "samples_2d.value"), "samples_2d.value", s.x_mm.size(),
+                        "sample");
+  s.standard_error = in.channels(in.get(s2, "standard_error", "samples_2d.standard_error"),
+                                 "samples_2d.standard_error", s.x_mm.size(), "sample");
+  return s;
+}
 
-  const json& masked = in.get(doc, "masked", "masked");
+// The masked pixel counts per channel.
+void read_masked(const FieldReader& in, const json& masked, MaskCounts& counts) {
   if (!masked.is_object()) in.fail("masked", "expected {\"saturated\", \"black\", \"non_finite\"}");
   in.only_known(masked, "masked.", {"saturated", "black", "non_finite"});
   const auto read_counts = [&](const char* key, std::array<std::int64_t, 3>& out) {
@@ -330,9 +336,32 @@ Profile profile_from_json(const json& doc, const std::string& source) {
     const auto values = in.counts(in.get(masked, key, field), field, 3);
     std::copy(values.begin(), values.end(), out.begin());
   };
-  read_counts("saturated", p.masked.saturated);
-  read_counts("black", p.masked.black);
-  read_counts("non_finite", p.masked.non_finite);
+  read_counts("saturated", counts.saturated);
+  read_counts("black", counts.black);
+  read_counts("non_finite", counts.non_finite);
+}
+
+}  // namespace
+
+std::string Profile::units() const {
+  return calibrated ? kCalibratedUnits : kRelativeUnits;
+}
+
+json profile_to_json(const Profile& profile) {
+  return json::parse(profile_to_ordered_json(profile).dump());
+}
+
+Profile profile_from_json(const json& doc, const std::string& source) {
+  const FieldReader in(source);
+  check_profile_format(in, doc, source);
+  Profile p;
+  read_calibration(in, doc, p);
+  read_geometry(in, doc, source, p);
+  if (doc.contains("system_response")) read_system_response(in, doc["system_response"], p);
+  read_beam(in, doc, p);
+  read_radial(in, in.get(doc, "radial", "radial"), p.radial);
+  if (doc.contains("samples_2d")) p.samples_2d = read_samples_2d(in, doc["samples_2d"]);
+  read_masked(in, in.get(doc, "masked", "masked"), p.masked);
   if (doc.contains("provenance")) {
     if (!doc["provenance"].is_object()) in.fail("provenance", "expected an object");
     p.provenance = doc["provenance"];

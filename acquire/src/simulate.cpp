@@ -164,11 +164,20 @@ imaging::ImageRgb white_reference_radiance(int size, double pixel_mm, double rho
   return image;
 }
 
-SimulateSummary run_simulation(const SimulateOptions& options, const std::filesystem::path& out_dir,
-                               const PhotonTransportProgress& progress) {
+namespace {
+
+// Set-up: the transport the run simulates, with the material's media, imaged unless only the
+// profile is wanted.
+PhotonTransportOptions simulation_transport(const SimulateOptions& options) {
   PhotonTransportOptions transport = options.transport;
   for (int c = 0; c < 3; ++c) transport.media[c] = options.material.medium(c);
   transport.image = !options.profile_only;
+  return transport;
+}
+
+// Set-up: the camera of the run, checked (when images are made) before the long simulation.
+CameraOptions simulation_camera(const SimulateOptions& options,
+                                const PhotonTransportOptions& transport) {
   // One seed drives every random choice: the camera's noise comes from the transport's seed, so
   // repeated captures with different --seed differ in their noise too. The same value is safe: the
   // camera's mt19937_64 streams and the transport's xoshiro streams mix it differently.
@@ -181,19 +190,13 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
         "--bracket-format dng: a RAW sensor records linear 16-bit codes (use --bits 16 "
         "and --response linear)");
   }
-  validate_photon_transport_options(transport);
-  AtomicOutputDir out(out_dir);  // checks the folder can be made before the long simulation
+  return camera;
+}
 
-  SimulateSummary summary;
-  const bool monte_carlo = options.source == RadianceSource::kMonteCarlo;
-  if (monte_carlo) {
-    summary.transport = simulate_photon_transport(transport, progress);
-  } else {
-    if (options.profile_only) throw Error("--profile-only: needs the Monte Carlo source");
-    summary.transport.options = transport;
-  }
-  const PhotonTransportResult& result = summary.transport;
-
+// Truth: what the run simulated and, for the Monte Carlo source, its totals; the camera's part is
+// added by write_camera_images.
+json truth_record(const SimulateOptions& options, const PhotonTransportOptions& transport,
+                  const PhotonTransportResult& result, bool monte_carlo) {
   json truth = {{"format", "lucent-simulation-truth"},
                 {"version", 1},
                 {"material", materials::material_to_json(options.material)},
@@ -210,100 +213,155 @@ SimulateSummary run_simulation(const SimulateOptions& options, const std::filesy
     truth["wall_seconds"] = result.wall_seconds;
     truth["threads_used"] = result.threads_used;
   }
+  return truth;
+}
 
-  if (!options.profile_only) {
-    const imaging::ImageRgb truth_radiance =
-        monte_carlo ? to_image(result, false)
-                    : model_radiance(options.material, options.source, transport);
-    // What the camera sees: the sample's light through the lens.
-    const imaging::ImageRgb radiance =
-        apply_lens(truth_radiance, transport.pixel_mm, options.lens_blur_mm, options.glare,
-                   options.glare_radius_mm);
-    const double pixel_area = transport.pixel_mm * transport.pixel_mm;
-    const double scale = camera_scale(camera, peak(radiance));
-    summary.camera_scale = scale;
-    imaging::write_exr(out.temporary() / "truth_radiance.exr", truth_radiance,
-                       {{"units", "radiance per unit incident power, mm^-2 sr^-1"}});
-    summary.files = {"truth_radiance.exr"};
-    if (monte_carlo) {
-      imaging::write_exr(out.temporary() / "truth_radiance_se.exr", to_image(result, true),
-                         {{"units", "standard error of truth_radiance, mm^-2 sr^-1"}});
-      summary.files.push_back("truth_radiance_se.exr");
-    }
+// Images: writes the brackets into the output folder in order, each with the next camera noise
+// stream, and lists their names among the files written.
+struct BracketWriter {
+  const std::filesystem::path& dir;
+  const CameraOptions& camera;
+  double scale;
+  BracketFormat format;
+  std::vector<std::string>& files;
+  std::uint64_t stream = 0;
 
-    Capture capture;
-    capture.pixel_pitch_mm = transport.pixel_mm;
-    capture.incidence_polar_deg = transport.incidence_deg;
-    capture.incidence_azimuth_deg = transport.azimuth_deg;
-    capture.view_deg = transport.view_deg;
-    capture.ior = options.material.ior;
-    if (std::isfinite(transport.thickness_mm)) capture.thickness_mm = transport.thickness_mm;
-    capture.transmitted = transport.far_side;
-    // At oblique incidence the light emerges ahead of the entry point, so the brightest region no
-    // longer marks it; a real rig marks it (the specular glint, a fiducial). The simulator knows
-    // it: the corner between the four middle pixels.
-    if (transport.incidence_deg > 0) {
-      capture.beam_point_px = std::array<double, 2>{transport.size / 2.0, transport.size / 2.0};
-    }
-    capture.response = camera.response;
-    const BracketFormat format = options.bracket_format;
-    std::uint64_t stream = 0;
-    for (std::size_t k = 0; k < camera.exposures_s.size(); ++k) {
-      const double t = camera.exposures_s[k];
-      const std::string name = bracket_name("bracket", k, format);
-      capture.sample.images.push_back(
-          write_bracket(out.temporary(), name, radiance, t, scale, camera, stream++, format));
-      summary.files.push_back(name);
-    }
-    json white_json = nullptr;
-    if (options.white_reference) {
-      const double sigma = options.white_spot_sigma_mm > 0 ? options.white_spot_sigma_mm
-                           : transport.beam_sigma_mm > 0   ? transport.beam_sigma_mm
-                                                           : transport.pixel_mm;
-      // The same beam on the reference, seen through the same lens.
-      const imaging::ImageRgb white = apply_lens(
-          white_reference_radiance(transport.size, transport.pixel_mm, options.white_reflectance,
-                                   sigma),
-          transport.pixel_mm, options.lens_blur_mm, options.glare, options.glare_radius_mm);
-      // The reference is far brighter than the sample: shorten its exposures by a power of two so
-      // that its peak, too, fills about auto_fill of the well at the shortest one.
-      const double ratio = peak(white) / peak(radiance);
-      const double shorten = std::max(1.0, std::exp2(std::ceil(std::log2(ratio))));
-      WhiteReference reference;
-      reference.reflectance = options.white_reflectance;
-      for (std::size_t k = 0; k < camera.exposures_s.size(); ++k) {
-        const double t = camera.exposures_s[k] / shorten;
-        const std::string name = bracket_name("white", k, format);
-        reference.images.images.push_back(
-            write_bracket(out.temporary(), name, white, t, scale, camera, stream++, format));
-        summary.files.push_back(name);
-      }
-      capture.white_reference = reference;
-      white_json = {{"reflectance", options.white_reflectance},
-                    {"spot_sigma_mm", sigma},
-                    {"exposure_divisor", shorten}};
-    }
-    if (options.dark_frame) {
-      const imaging::ImageRgb black(transport.size, transport.size, 0.0f);
-      const std::string name = std::string("dark") + extension(format);
-      write_bracket(out.temporary(), name, black, camera.exposures_s.back(), scale, camera,
-                    stream++, format);
-      capture.dark = name;
-      summary.files.push_back(name);
-    }
-    capture.provenance = {{"tool", std::string("lucent simulate ") + kVersion},
-                          {"material", options.material.name},
-                          {"truth", "truth.json"}};
-    write_capture(out.temporary() / "capture.json", capture);
-    summary.files.push_back("capture.json");
-    truth["camera"] = camera_to_json(camera, scale);
-    truth["camera"]["bracket_format"] = format == BracketFormat::kDng ? "dng" : "png";
-    truth["white_reference"] = white_json;
-    truth["lens"] = {{"blur_mm", options.lens_blur_mm},
-                     {"glare", options.glare},
-                     {"glare_radius_mm", options.glare_radius_mm}};
-    truth["pixel_area_mm2"] = pixel_area;
+  Bracket write(const std::string& name, const imaging::ImageRgb& radiance, double t) {
+    Bracket bracket = write_bracket(dir, name, radiance, t, scale, camera, stream++, format);
+    files.push_back(name);
+    return bracket;
   }
+};
+
+// Images: the capture's geometry and response, as a rig would record them.
+Capture capture_geometry(const SimulateOptions& options, const PhotonTransportOptions& transport,
+                         const CameraOptions& camera) {
+  Capture capture;
+  capture.pixel_pitch_mm = transport.pixel_mm;
+  capture.incidence_polar_deg = transport.incidence_deg;
+  capture.incidence_azimuth_deg = transport.azimuth_deg;
+  capture.view_deg = transport.view_deg;
+  capture.ior = options.material.ior;
+  if (std::isfinite(transport.thickness_mm)) capture.thickness_mm = transport.thickness_mm;
+  capture.transmitted = transport.far_side;
+  // At oblique incidence the light emerges ahead of the entry point, so the brightest region no
+  // longer marks it; a real rig marks it (the specular glint, a fiducial). The simulator knows
+  // it: the corner between the four middle pixels.
+  if (transport.incidence_deg > 0) {
+    capture.beam_point_px = std::array<double, 2>{transport.size / 2.0, transport.size / 2.0};
+  }
+  capture.response = camera.response;
+  return capture;
+}
+
+// Images: the white reference's brackets, added to the capture; returns its truth record.
+json write_white_reference(const SimulateOptions& options, const PhotonTransportOptions& transport,
+                           const imaging::ImageRgb& radiance, BracketWriter& brackets,
+                           Capture& capture) {
+  const CameraOptions& camera = brackets.camera;
+  const double sigma = options.white_spot_sigma_mm > 0 ? options.white_spot_sigma_mm
+                       : transport.beam_sigma_mm > 0   ? transport.beam_sigma_mm
+                                                       : transport.pixel_mm;
+  // The same beam on the reference, seen through the same lens.
+  const imaging::ImageRgb white =
+      apply_lens(white_reference_radiance(transport.size, transport.pixel_mm,
+                                          options.white_reflectance, sigma),
+                 transport.pixel_mm, options.lens_blur_mm, options.glare, options.glare_radius_mm);
+  // The reference is far brighter than the sample: shorten its exposures by a power of two so
+  // that its peak, too, fills about auto_fill of the well at the shortest one.
+  const double ratio = peak(white) / peak(radiance);
+  const double shorten = std::max(1.0, std::exp2(std::ceil(std::log2(ratio))));
+  WhiteReference reference;
+  reference.reflectance = options.white_reflectance;
+  for (std::size_t k = 0; k < camera.exposures_s.size(); ++k) {
+    const double t = camera.exposures_s[k] / shorten;
+    const std::string name = bracket_name("white", k, brackets.format);
+    reference.images.images.push_back(brackets.write(name, white, t));
+  }
+  capture.white_reference = reference;
+  return {{"reflectance", options.white_reflectance},
+          {"spot_sigma_mm", sigma},
+          {"exposure_divisor", shorten}};
+}
+
+// Images: the truth radiance, the sample's brackets, the white reference, the dark frame and
+// capture.json; adds the camera's part of the truth record.
+void write_camera_images(const SimulateOptions& options, const PhotonTransportOptions& transport,
+                         const CameraOptions& camera, bool monte_carlo, const AtomicOutputDir& out,
+                         SimulateSummary& summary, json& truth) {
+  const PhotonTransportResult& result = summary.transport;
+  const imaging::ImageRgb truth_radiance =
+      monte_carlo ? to_image(result, false)
+                  : model_radiance(options.material, options.source, transport);
+  // What the camera sees: the sample's light through the lens.
+  const imaging::ImageRgb radiance =
+      apply_lens(truth_radiance, transport.pixel_mm, options.lens_blur_mm, options.glare,
+                 options.glare_radius_mm);
+  const double pixel_area = transport.pixel_mm * transport.pixel_mm;
+  const double scale = camera_scale(camera, peak(radiance));
+  summary.camera_scale = scale;
+  imaging::write_exr(out.temporary() / "truth_radiance.exr", truth_radiance,
+                     {{"units", "radiance per unit incident power, mm^-2 sr^-1"}});
+  summary.files = {"truth_radiance.exr"};
+  if (monte_carlo) {
+    imaging::write_exr(out.temporary() / "truth_radiance_se.exr", to_image(result, true),
+                       {{"units", "standard error of truth_radiance, mm^-2 sr^-1"}});
+    summary.files.push_back("truth_radiance_se.exr");
+  }
+
+  Capture capture = capture_geometry(options, transport, camera);
+  const BracketFormat format = options.bracket_format;
+  BracketWriter brackets{out.temporary(), camera, scale, format, summary.files};
+  for (std::size_t k = 0; k < camera.exposures_s.size(); ++k) {
+    const double t = camera.exposures_s[k];
+    const std::string name = bracket_name("bracket", k, format);
+    capture.sample.images.push_back(brackets.write(name, radiance, t));
+  }
+  json white_json = nullptr;
+  if (options.white_reference)
+    white_json = write_white_reference(options, transport, radiance, brackets, capture);
+  if (options.dark_frame) {
+    const imaging::ImageRgb black(transport.size, transport.size, 0.0f);
+    const std::string name = std::string("dark") + extension(format);
+    brackets.write(name, black, camera.exposures_s.back());
+    capture.dark = name;
+  }
+  capture.provenance = {{"tool", std::string("lucent simulate ") + kVersion},
+                        {"material", options.material.name},
+                        {"truth", "truth.json"}};
+  write_capture(out.temporary() / "capture.json", capture);
+  summary.files.push_back("capture.json");
+  truth["camera"] = camera_to_json(camera, scale);
+  truth["camera"]["bracket_format"] = format == BracketFormat::kDng ? "dng" : "png";
+  truth["white_reference"] = white_json;
+  truth["lens"] = {{"blur_mm", options.lens_blur_mm},
+                   {"glare", options.glare},
+                   {"glare_radius_mm", options.glare_radius_mm}};
+  truth["pixel_area_mm2"] = pixel_area;
+}
+
+}  // namespace
+
+SimulateSummary run_simulation(const SimulateOptions& options, const std::filesystem::path& out_dir,
+                               const PhotonTransportProgress& progress) {
+  const PhotonTransportOptions transport = simulation_transport(options);
+  const CameraOptions camera = simulation_camera(options, transport);
+  validate_photon_transport_options(transport);
+  AtomicOutputDir out(out_dir);  // checks the folder can be made before the long simulation
+
+  SimulateSummary summary;
+  const bool monte_carlo = options.source == RadianceSource::kMonteCarlo;
+  if (monte_carlo) {
+    summary.transport = simulate_photon_transport(transport, progress);
+  } else {
+    if (options.profile_only) throw Error("--profile-only: needs the Monte Carlo source");
+    summary.transport.options = transport;
+  }
+  const PhotonTransportResult& result = summary.transport;
+
+  json truth = truth_record(options, transport, result, monte_carlo);
+  if (!options.profile_only)
+    write_camera_images(options, transport, camera, monte_carlo, out, summary, truth);
   check_finite_json(truth, "truth.json");
   write_file_atomically(out.temporary() / "truth.json", truth.dump(2) + "\n");
   summary.files.push_back("truth.json");

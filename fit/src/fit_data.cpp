@@ -37,13 +37,13 @@ std::vector<std::string> split(const std::string& line) {
   return out;
 }
 
-}  // namespace
+// The key=value tokens of a CSV's leading comment lines.
+using CommentFields = std::map<std::string, std::string>;
 
-ProfileData parse_profile_csv(std::string_view text, const std::string& source) {
-  std::istringstream in{std::string(text)};
-  std::string line;
-  int line_number = 0;
-  std::map<std::string, std::string> meta;  // key=value tokens of the leading comment lines
+// Stage 1: the comment lines before the header. Leaves `line` holding the header line (empty when
+// the text ends first) and `line_number` its number.
+CommentFields read_comment_fields(std::istream& in, std::string& line, int& line_number) {
+  CommentFields meta;
   while (std::getline(in, line)) {
     ++line_number;
     const std::string t = trim(line);
@@ -56,7 +56,12 @@ ProfileData parse_profile_csv(std::string_view text, const std::string& source) 
       if (eq != std::string::npos && eq > 0) meta[token.substr(0, eq)] = token.substr(eq + 1);
     }
   }
-  const std::vector<std::string> header = split(trim(line));
+  return meta;
+}
+
+// Stage 2: each header column's index by name; every column named once, r_mm among them.
+std::map<std::string, int> index_header_columns(const std::vector<std::string>& header,
+                                                const std::string& source, int line_number) {
   std::map<std::string, int> column;
   for (std::size_t i = 0; i < header.size(); ++i) {
     if (header[i].empty()) {
@@ -68,35 +73,40 @@ ProfileData parse_profile_csv(std::string_view text, const std::string& source) 
                   " appears twice in the header (which one is meant?)");
     }
   }
-  const auto has = [&](const std::string& name) { return column.count(name) > 0; };
-  if (!has("r_mm")) {
+  if (column.count("r_mm") == 0) {
     throw Error(source + ": line " + std::to_string(line_number) +
                 ": expected a header with r_mm and R (or R_r,R_g,R_b) columns");
   }
-  ProfileData d;
-  d.source = source;
-  d.exitance = true;  // CSV values are per mm^2 per unit power entering the sample
-  d.per_incident_power = false;
-  const auto meta_number = [&](const std::string& key) -> std::optional<double> {
-    const auto it = meta.find(key);
-    if (it == meta.end()) return std::nullopt;
-    // "1.5" or per channel "1.5,1.5,1.5" (lucent simulate): the channels must agree.
-    const std::vector<std::string> parts = split(it->second);
-    std::optional<double> value;
-    for (const std::string& part : parts) {
-      double v = 0;
-      const auto [end, ec] = std::from_chars(part.data(), part.data() + part.size(), v);
-      if (ec != std::errc() || end != part.data() + part.size() || !std::isfinite(v))
-        throw Error(source + ": comment field " + key + "=" + it->second + ": expected a number");
-      if (value && std::abs(*value - v) > 1e-12)
-        throw Error(source + ": comment field " + key + "=" + it->second +
-                    ": the channels differ; lucent fit takes one value for all channels");
-      value = v;
-    }
-    return value;
-  };
-  if (auto eta = meta_number("ior")) d.eta = *eta;
-  if (auto eta = meta_number("eta")) {
+  return column;
+}
+
+// A numeric comment field, nullopt when absent. "1.5" or per channel "1.5,1.5,1.5" (lucent
+// simulate): the channels must agree.
+std::optional<double> comment_number(const CommentFields& meta, const std::string& key,
+                                     const std::string& source) {
+  const auto it = meta.find(key);
+  if (it == meta.end()) return std::nullopt;
+  const std::vector<std::string> parts = split(it->second);
+  std::optional<double> value;
+  for (const std::string& part : parts) {
+    double v = 0;
+    const auto [end, ec] = std::from_chars(part.data(), part.data() + part.size(), v);
+    if (ec != std::errc() || end != part.data() + part.size() || !std::isfinite(v))
+      throw Error(source + ": comment field " + key + "=" + it->second + ": expected a number");
+    if (value && std::abs(*value - v) > 1e-12)
+      throw Error(source + ": comment field " + key + "=" + it->second +
+                  ": the channels differ; lucent fit takes one value for all channels");
+    value = v;
+  }
+  return value;
+}
+
+// Stage 3a: the comment fields of what was measured and how: the relative index, the quantity and
+// its unit, calibration, the view direction and the pixel.
+void apply_measurement_fields(const CommentFields& meta, const std::string& source,
+                              ProfileData& d) {
+  if (auto eta = comment_number(meta, "ior", source)) d.eta = *eta;
+  if (auto eta = comment_number(meta, "eta", source)) {
     if (d.eta && std::abs(*d.eta - *eta) > 1e-9)
       throw Error(source + ": comment fields ior= and eta= disagree (" + meta.at("ior") + " and " +
                   meta.at("eta") + "): give one relative index");
@@ -118,16 +128,21 @@ ProfileData parse_profile_csv(std::string_view text, const std::string& source) 
       throw Error(source + ": comment field calibrated=" + it->second + ": expected true or false");
     d.calibrated = it->second == "true";
   }
-  if (auto view = meta_number("view_deg")) {
+  if (auto view = comment_number(meta, "view_deg", source)) {
     if (!(*view >= 0 && *view < 90))
       throw Error(source + ": comment field view_deg: expected [0, 90) degrees");
     d.view_deg = *view;
   }
-  if (auto pixel = meta_number("pixel_mm")) {
+  if (auto pixel = comment_number(meta, "pixel_mm", source)) {
     if (!(*pixel >= 0 && *pixel < 1e3))
       throw Error(source + ": comment field pixel_mm: expected a pixel side in [0, 1000) mm");
     d.radial.pixel_mm = *pixel;
   }
+}
+
+// Stage 3b: the calibration's relative standard error per channel (calibration_relative_se=).
+void apply_calibration_se_field(const CommentFields& meta, const std::string& source,
+                                ProfileData& d) {
   if (auto it = meta.find("calibration_relative_se"); it != meta.end()) {
     const std::vector<std::string> parts = split(it->second);
     if (parts.size() != 3)
@@ -142,11 +157,15 @@ ProfileData parse_profile_csv(std::string_view text, const std::string& source) 
       d.calibration_relative_se[c] = v;
     }
   }
-  // thickness_mm= (inf: semi-infinite, as the simulator writes it) and side=reflected|transmitted.
+}
+
+// Stage 3c: a slab's comment fields, thickness_mm= (inf: semi-infinite, as the simulator writes
+// it) and side=reflected|transmitted.
+void apply_slab_fields(const CommentFields& meta, const std::string& source, ProfileData& d) {
   // (The simulator writes an empty value or "inf" for a semi-infinite sample.)
   if (auto it = meta.find("thickness_mm");
       it != meta.end() && !it->second.empty() && it->second != "inf" && it->second != "infinite") {
-    const auto thickness = meta_number("thickness_mm");
+    const auto thickness = comment_number(meta, "thickness_mm", source);
     if (!(*thickness > 0 && *thickness <= 1e4))
       throw Error(source + ": comment field thickness_mm=" + it->second +
                   ": expected a slab thickness in (0, 10000] mm, or inf");
@@ -160,7 +179,11 @@ ProfileData parse_profile_csv(std::string_view text, const std::string& source) 
     if (d.transmitted && !d.thickness_mm)
       throw Error(source + ": comment field side=transmitted: the far side needs thickness_mm=");
   }
-  // The white reference's system response (acquire): rms radius and the radial profile.
+}
+
+// Stage 3d: the white reference's system response (acquire): rms radius and the radial profile.
+void apply_system_response_fields(const CommentFields& meta, const std::string& source,
+                                  ProfileData& d) {
   if (auto it = meta.find("system_response_r_mm"); it != meta.end()) {
     const auto list = [&](const std::string& key) {
       std::vector<double> out;
@@ -184,27 +207,47 @@ ProfileData parse_profile_csv(std::string_view text, const std::string& source) 
     for (std::size_t i = 1; i < d.response_r_mm.size(); ++i)
       if (!(d.response_r_mm[i] > d.response_r_mm[i - 1]) || d.response_r_mm[0] < 0)
         throw Error(source + ": comment field system_response_r_mm=: expected radii >= 0, rising");
-    if (auto rms = meta_number("system_response_rms_mm")) {
+    if (auto rms = comment_number(meta, "system_response_rms_mm", source)) {
       if (!(*rms >= 0)) throw Error(source + ": comment field system_response_rms_mm: expected >= 0");
       d.response_rms_mm = *rms;
     }
   }
-  if (auto incidence = meta_number("incidence_deg")) {
+}
+
+// Stage 3: every comment field into `d`, checked in this order (the first error found is the one
+// reported).
+void apply_comment_fields(const CommentFields& meta, const std::string& source, ProfileData& d) {
+  apply_measurement_fields(meta, source, d);
+  apply_calibration_se_field(meta, source, d);
+  apply_slab_fields(meta, source, d);
+  apply_system_response_fields(meta, source, d);
+  if (auto incidence = comment_number(meta, "incidence_deg", source)) {
     if (!(*incidence >= 0 && *incidence < 90))
       throw Error(source + ": comment field incidence_deg: expected [0, 90) degrees");
     d.incidence_polar_deg = *incidence;
   }
+}
+
+// Each channel's value and standard-error column index (-1: none).
+struct ValueColumns {
+  std::array<int, 3> value{-1, -1, -1}, standard_error{-1, -1, -1};
+};
+
+// Stage 4: the value and standard-error columns of each channel, and so which channels carry data.
+ValueColumns find_value_columns(const std::map<std::string, int>& column, const std::string& source,
+                                int line_number, ProfileData& d) {
+  const auto has = [&](const std::string& name) { return column.count(name) > 0; };
   std::array<int, 3> value_col{-1, -1, -1}, se_col{-1, -1, -1};
   const char* suffix[3] = {"_r", "_g", "_b"};
   if (has("R")) {
-    value_col = {column["R"], column["R"], column["R"]};
-    if (has("se")) se_col = {column["se"], column["se"], column["se"]};
+    value_col = {column.at("R"), column.at("R"), column.at("R")};
+    if (has("se")) se_col = {column.at("se"), column.at("se"), column.at("se")};
     d.channels = {true, false, false};
   } else {
     for (int c = 0; c < 3; ++c) {
       const std::string name = std::string("R") + suffix[c];
-      if (has(name)) value_col[c] = column[name];
-      if (has(std::string("se") + suffix[c])) se_col[c] = column[std::string("se") + suffix[c]];
+      if (has(name)) value_col[c] = column.at(name);
+      if (has(std::string("se") + suffix[c])) se_col[c] = column.at(std::string("se") + suffix[c]);
       d.channels[c] = value_col[c] >= 0;
     }
     if (!d.channels[0] && !d.channels[1] && !d.channels[2]) {
@@ -212,10 +255,28 @@ ProfileData parse_profile_csv(std::string_view text, const std::string& source) 
                   ": expected value columns R or R_r,R_g,R_b beside r_mm");
     }
   }
-  const int inner = has("r_inner_mm") ? column["r_inner_mm"] : -1;
-  const int outer = has("r_outer_mm") ? column["r_outer_mm"] : -1;
+  return {value_col, se_col};
+}
+
+// What reading the rows leaves to note: whether errors were assumed, and per channel the bins
+// with a zero standard error.
+struct RowTally {
   bool assumed_errors = false;
   std::array<int, 3> zero_se{};
+};
+
+// Stage 5: the data rows after the header (at `line_number`) into d.radial, checked field by
+// field.
+RowTally read_profile_rows(std::istream& in, int line_number,
+                           const std::vector<std::string>& header,
+                           const std::map<std::string, int>& column, const ValueColumns& columns,
+                           const std::string& source, ProfileData& d) {
+  const std::array<int, 3>& value_col = columns.value;
+  const std::array<int, 3>& se_col = columns.standard_error;
+  const int inner = column.count("r_inner_mm") > 0 ? column.at("r_inner_mm") : -1;
+  const int outer = column.count("r_outer_mm") > 0 ? column.at("r_outer_mm") : -1;
+  RowTally tally;
+  std::string line;
   while (std::getline(in, line)) {
     ++line_number;
     if (trim(line).empty() || trim(line)[0] == '#') continue;
@@ -235,7 +296,7 @@ ProfileData parse_profile_csv(std::string_view text, const std::string& source) 
       }
       return v;
     };
-    const double r = number(column["r_mm"]);
+    const double r = number(column.at("r_mm"));
     if (r < 0) throw Error(where + "r_mm must be >= 0");
     std::array<double, 3> v{}, se{};
     for (int c = 0; c < 3; ++c) {
@@ -246,10 +307,10 @@ ProfileData parse_profile_csv(std::string_view text, const std::string& source) 
           throw Error(where + "column " + header[se_col[c]] + ": expected a standard error >= 0");
         // 0: a Monte Carlo bin no photon reached (value 0 too): kept out of the fit (the fit
         // uses only samples with a standard error > 0), counted.
-        if (se[c] == 0 && d.channels[c]) ++zero_se[c];
+        if (se[c] == 0 && d.channels[c]) ++tally.zero_se[c];
       } else {
         se[c] = 0.05 * std::abs(v[c]);  // documented assumption: 5% relative error
-        assumed_errors = true;
+        tally.assumed_errors = true;
       }
     }
     const double r_inner = inner >= 0 ? number(inner) : r;
@@ -272,7 +333,13 @@ ProfileData parse_profile_csv(std::string_view text, const std::string& source) 
       d.radial.standard_error[c].push_back(se[c]);
     }
   }
-  if (assumed_errors)
+  return tally;
+}
+
+// Stage 6: notes on assumed errors and skipped bins; a channel with no data at all is dropped.
+void note_skipped_data(const RowTally& tally, const std::string& source, ProfileData& d) {
+  const std::array<int, 3>& zero_se = tally.zero_se;
+  if (tally.assumed_errors)
     d.notes.push_back(source + ": no standard-error columns; 5% relative errors assumed");
   const char* names[3] = {"R", "G", "B"};
   for (int c = 0; c < 3; ++c) {
@@ -288,6 +355,25 @@ ProfileData parse_profile_csv(std::string_view text, const std::string& source) 
                         " bins with a zero standard error (no data) skipped");
     }
   }
+}
+
+}  // namespace
+
+ProfileData parse_profile_csv(std::string_view text, const std::string& source) {
+  std::istringstream in{std::string(text)};
+  std::string line;
+  int line_number = 0;
+  const CommentFields meta = read_comment_fields(in, line, line_number);
+  const std::vector<std::string> header = split(trim(line));
+  const std::map<std::string, int> column = index_header_columns(header, source, line_number);
+  ProfileData d;
+  d.source = source;
+  d.exitance = true;  // CSV values are per mm^2 per unit power entering the sample
+  d.per_incident_power = false;
+  apply_comment_fields(meta, source, d);
+  const ValueColumns columns = find_value_columns(column, source, line_number, d);
+  const RowTally tally = read_profile_rows(in, line_number, header, column, columns, source, d);
+  note_skipped_data(tally, source, d);
   if (d.radial.size() == 0) throw Error(source + ": the profile is empty (a header and no rows)");
   return d;
 }

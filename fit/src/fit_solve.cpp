@@ -137,7 +137,7 @@ void ProfileSolve::add_observations() {
             nullptr, scale);
         record(-1, nullptr, 1);  // the prior's residual: not a sample
         calibration_blocks.emplace_back(
-            scale, std::string("log calibration[") + kSolveChannelNames[c] +
+            scale, std::string("log calibration[") + kChannelNames[c] +
                        (data.size() > 1 ? ", input " + std::to_string(di + 1) : "") + "]");
       }
       const bool scale_free = scale != &p.log_scale || relative;
@@ -238,7 +238,7 @@ void ProfileSolve::add_per_sample_blocks(const Observations& o, const ProfileDat
 void ProfileSolve::check_samples_and_constrain() {
   for (int c = 0; c < 3; ++c) {
     if (channels[c] && samples[c] < 2) {
-      throw Error(std::string("fit: channel ") + kSolveChannelNames[c] + " has " +
+      throw Error(std::string("fit: channel ") + kChannelNames[c] + " has " +
                   std::to_string(samples[c]) + " usable samples outside the exclusion radius (" +
                   std::to_string(exclude[c]) +
                   " mm) and above the noise floor; at least 2 are needed for sigma_a and sigma_s'");
@@ -286,8 +286,8 @@ bool ProfileSolve::evaluate_at_solution() {
   for (int c = 0; c < 3; ++c) {
     if (!channels[c]) continue;
     blocks.push_back(p.ab[c].data());
-    names.push_back(std::string("log sigma_a[") + kSolveChannelNames[c] + "]");
-    names.push_back(std::string("log sigma_s'[") + kSolveChannelNames[c] + "]");
+    names.push_back(std::string("log sigma_a[") + kChannelNames[c] + "]");
+    names.push_back(std::string("log sigma_s'[") + kChannelNames[c] + "]");
   }
   if (relative) blocks.push_back(&p.log_scale), names.push_back("log scale");
   if (options.fit_ior) blocks.push_back(&p.eta), names.push_back("eta");

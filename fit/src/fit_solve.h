@@ -13,6 +13,9 @@
 
 namespace lucent::fit::detail {
 
+/// The channels by name, in messages and parameter names.
+inline constexpr const char* kChannelNames[3] = {"R", "G", "B"};
+
 /// A channel whose residuals have a robust rms (1.4826 x median |r|) above this many standard
 /// errors does not fit its data, and the fit is not called converged. A good fit has about 1; up
 /// to here a model's lack of fit (the directional dipole on oblique Monte Carlo captures reaches

@@ -18,8 +18,6 @@
 
 namespace lucent::fit::detail {
 
-inline constexpr const char* kChannelNames[3] = {"R", "G", "B"};
-
 // Shares of a default fit's time before each stage, for the progress line (measured on the bundled
 // marble_45deg, a 2D oblique fit of about 12 s; a radial fit takes under a second and shows none).
 inline constexpr double kShareTabulated = 0.03, kShareDirectional = 0.10,

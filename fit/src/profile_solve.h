@@ -23,8 +23,6 @@
 
 namespace lucent::fit::detail {
 
-inline constexpr const char* kSolveChannelNames[3] = {"R", "G", "B"};
-
 struct SolveParameters {  // the parameters Ceres moves, and what the residual blocks point into
   std::array<std::array<double, 2>, 3> ab{};
   double log_scale = 0;

@@ -233,43 +233,79 @@ std::vector<std::string> texts_to_measure(const PlotFigure& f,
   return t;
 }
 
-FigurePlan plan_figure(const PlotFigure& f, double W, double H, double c, const TextMeter& m,
-                       std::vector<PanelPlan> plans) {
-  FigurePlan fig;
-  const double margin = 1.2 * c, row = 1.5 * c;
+namespace {
+
+// Page margin and legend row height, from the character height c (mm).
+double page_margin(double c) {
+  return 1.2 * c;
+}
+double legend_row(double c) {
+  return 1.5 * c;
+}
+
+// The widest labels of all panels (mm), and whether any panel has a y or colour label.
+struct LabelWidths {
   double y_ticks = 0, legend_text = 0, x_tick_half = 0, colour_ticks = 0;
   bool y_label = false, colour_label = false;
+};
+
+// Stage 1 of plan_figure: measures the labels that set the plot boxes' left and right edges.
+LabelWidths measure_labels(const PlotFigure& f, const std::vector<PanelPlan>& plans,
+                           const TextMeter& m) {
+  LabelWidths w;
   for (std::size_t i = 0; i < plans.size(); ++i) {
     const PlotPanel& p = f.panels[i];
-    for (const std::string& l : plans[i].y.labels) y_ticks = std::max(y_ticks, m.width(l));
-    y_label = y_label || !p.y_label.empty();
+    for (const std::string& l : plans[i].y.labels) w.y_ticks = std::max(w.y_ticks, m.width(l));
+    w.y_label = w.y_label || !p.y_label.empty();
     for (const PlotSeries* s : plans[i].legend)
-      legend_text = std::max(legend_text, m.width(escaped(s->label)));
+      w.legend_text = std::max(w.legend_text, m.width(escaped(s->label)));
     if (!plans[i].x.labels.empty())
-      x_tick_half = std::max(x_tick_half, 0.5 * m.width(plans[i].x.labels.back()));
+      w.x_tick_half = std::max(w.x_tick_half, 0.5 * m.width(plans[i].x.labels.back()));
     for (const std::string& l : plans[i].colour.labels)
-      colour_ticks = std::max(colour_ticks, m.width(l));
-    colour_label = colour_label || (plans[i].map && !p.colour_label.empty());
+      w.colour_ticks = std::max(w.colour_ticks, m.width(l));
+    w.colour_label = w.colour_label || (plans[i].map && !p.colour_label.empty());
   }
-  fig.legend_entry = legend_text > 0 ? 3.4 * c + legend_text : 0;
-  const double legend_box = fig.legend_entry + 0.8 * c;
-  const double left = margin + (y_label ? 1.7 * c : 0) + y_ticks + 0.6 * c;
-  fig.y_label_x = margin + 0.5 * c;
-  const double right_with_legend = W - (c + legend_box + margin);
-  const bool legend_right = f.legend == LegendPlace::kRight && legend_box > 0.8 * c &&
-                            right_with_legend - left >= 0.45 * W;
-  const double right =
-      legend_right ? right_with_legend : W - std::max(margin, x_tick_half + 0.3 * c);
-  const double map_right =
-      W - (2.4 * c + 0.5 * c + colour_ticks + (colour_label ? 1.9 * c : 0) + margin);
-  if (!(right - left > 4 * c) || !(map_right - left > 4 * c))
+  return w;
+}
+
+// The x edges every panel shares, mm.
+struct Columns {
+  double left = 0, right = 0, map_right = 0;
+  double legend_box = 0;  // the legend's width
+  bool legend_right = false;
+};
+
+// Stage 2 of plan_figure: the plot boxes' left and right edges, and whether the legend goes to
+// the right of the plots or below them.
+Columns plan_columns(const PlotFigure& f, const LabelWidths& widths, double legend_entry, double W,
+                     double c) {
+  const double margin = page_margin(c);
+  Columns col;
+  col.legend_box = legend_entry + 0.8 * c;
+  col.left = margin + (widths.y_label ? 1.7 * c : 0) + widths.y_ticks + 0.6 * c;
+  const double right_with_legend = W - (c + col.legend_box + margin);
+  col.legend_right = f.legend == LegendPlace::kRight && col.legend_box > 0.8 * c &&
+                     right_with_legend - col.left >= 0.45 * W;
+  col.right =
+      col.legend_right ? right_with_legend : W - std::max(margin, widths.x_tick_half + 0.3 * c);
+  col.map_right =
+      W - (2.4 * c + 0.5 * c + widths.colour_ticks + (widths.colour_label ? 1.9 * c : 0) + margin);
+  if (!(col.right - col.left > 4 * c) || !(col.map_right - col.left > 4 * c))
     throw Error("the figure is too narrow for its labels");
-  // Heights above and below each plot box.
+  return col;
+}
+
+// Stage 3 of plan_figure: each panel's title and the heights above and below its plot box.
+// Returns the page height those and the margins take, mm.
+double plan_panel_surrounds(const PlotFigure& f, const Columns& col, double legend_entry, double W,
+                            double c, const TextMeter& m, std::vector<PanelPlan>& plans) {
+  const double margin = page_margin(c), row = legend_row(c);
+  const double left = col.left, right = col.right;
   double fixed = 2 * margin + 0.8 * c * double(std::max<std::size_t>(plans.size(), 1) - 1);
   for (std::size_t i = 0; i < plans.size(); ++i) {
     const PlotPanel& p = f.panels[i];
     PanelPlan& plan = plans[i];
-    plan.plot.x0 = left, plan.plot.x1 = plan.map ? map_right : right;
+    plan.plot.x0 = left, plan.plot.x1 = plan.map ? col.map_right : right;
     if (!p.title.empty()) {
       plan.title = fit_text(p.title, (W - margin - left) / 1.15, 2, m);
       plan.title.scale *= 1.15, plan.title.widest *= 1.15;
@@ -281,36 +317,49 @@ FigurePlan plan_figure(const PlotFigure& f, double W, double H, double c, const 
     for (const PlotMap& mp : p.maps) map_titles = map_titles || !mp.title.empty();
     if (map_titles) plan.top += 1.5 * c;
     plan.bottom = 1.7 * c + (p.x_label.empty() ? 0 : 1.6 * c);
-    if (!legend_right && !plan.legend.empty()) {
-      plan.legend_columns =
-          std::max(1, int((right - left + 1.5 * c) / (fig.legend_entry + 1.5 * c)));
+    if (!col.legend_right && !plan.legend.empty()) {
+      plan.legend_columns = std::max(1, int((right - left + 1.5 * c) / (legend_entry + 1.5 * c)));
       const int rows = int((plan.legend.size() + plan.legend_columns - 1) / plan.legend_columns);
       plan.bottom += 0.6 * c + rows * row + 0.4 * c;
     }
     fixed += plan.top + plan.bottom;
   }
+  return fixed;
+}
+
+// Stage 4 of plan_figure: the footer's lines fitted to the page width. Returns its height, mm
+// (0 without a footer).
+double plan_footer(const PlotFigure& f, double W, double c, const TextMeter& m,
+                   std::vector<FittedText>& footer) {
+  const double margin = page_margin(c);
   double footer_height = 0;
   for (const std::string& line : f.footer) {
-    fig.footer.push_back(fit_text(line, (W - 2 * margin) / 0.9, 100, m));
-    fig.footer.back().scale *= 0.9, fig.footer.back().widest *= 0.9;
-    footer_height += double(fig.footer.back().lines.size()) * 1.45 * fig.footer.back().scale * c;
+    footer.push_back(fit_text(line, (W - 2 * margin) / 0.9, 100, m));
+    footer.back().scale *= 0.9, footer.back().widest *= 0.9;
+    footer_height += double(footer.back().lines.size()) * 1.45 * footer.back().scale * c;
   }
   if (footer_height > 0) footer_height += 0.6 * c;
-  const double available = H - fixed - footer_height;
-  if (!(available >= 2.5 * c * double(plans.size()))) {
-    throw Error("the figure (" + number_label(W / kMmPerPoint) + " x " +
-                number_label(H / kMmPerPoint) + ") is too small for its " +
-                std::to_string(plans.size()) + " panels and " + std::to_string(f.footer.size()) +
-                " footer lines");
-  }
-  // Plot heights by weight; a row of maps keeps no more than its width allows, the rest goes to
-  // the other panels.
-  double total_weight = 0, line_weight = 0, spare = 0;
+  return footer_height;
+}
+
+// Each panel's plot box height, mm, and the height maps gave up to the line panels.
+struct PlotHeights {
+  std::vector<double> heights;
+  double line_weight = 0, spare = 0;
+};
+
+// Stage 5 of plan_figure: plot heights by weight; a row of maps keeps no more than its width
+// allows, the rest goes to the other panels.
+PlotHeights share_plot_heights(const PlotFigure& f, const std::vector<PanelPlan>& plans,
+                               const Columns& col, double available, double c) {
+  PlotHeights out;
+  double total_weight = 0;
   for (const PlotPanel& p : f.panels) {
     total_weight += std::max(p.height_weight, 0.0);
-    if (p.maps.empty()) line_weight += std::max(p.height_weight, 0.0);
+    if (p.maps.empty()) out.line_weight += std::max(p.height_weight, 0.0);
   }
-  std::vector<double> heights(plans.size());
+  std::vector<double>& heights = out.heights;
+  heights.resize(plans.size());
   for (std::size_t i = 0; i < plans.size(); ++i) {
     const double w = std::max(f.panels[i].height_weight, 0.0);
     heights[i] = total_weight > 0 ? available * w / total_weight : available / plans.size();
@@ -319,19 +368,30 @@ FigurePlan plan_figure(const PlotFigure& f, double W, double H, double c, const 
     for (const PlotMap& mp : f.panels[i].maps)
       aspect += std::abs((mp.x_max - mp.x_min) / (mp.y_max - mp.y_min));
     const double gaps = 1.2 * c * double(f.panels[i].maps.size() - 1);
-    const double natural =
-        aspect > 0 && std::isfinite(aspect) ? (map_right - left - gaps) / aspect : heights[i];
+    const double natural = aspect > 0 && std::isfinite(aspect)
+                               ? (col.map_right - col.left - gaps) / aspect
+                               : heights[i];
     if (natural < heights[i]) {
-      if (line_weight > 0) spare += heights[i] - natural;
+      if (out.line_weight > 0) out.spare += heights[i] - natural;
       heights[i] = natural;
     }
   }
+  return out;
+}
+
+// Stage 6 of plan_figure: stacks the panels from the top of the page and places each one's plot,
+// title, maps, colour bar and legend boxes.
+void place_panels(const PlotFigure& f, const Columns& col, const PlotHeights& sizes,
+                  double legend_entry, double H, double c, std::vector<PanelPlan>& plans) {
+  const double margin = page_margin(c), row = legend_row(c);
+  const double left = col.left;
   double y = H - margin;
   for (std::size_t i = 0; i < plans.size(); ++i) {
     const PlotPanel& p = f.panels[i];
     PanelPlan& plan = plans[i];
-    double h = heights[i];
-    if (!plan.map && line_weight > 0) h += spare * std::max(p.height_weight, 0.0) / line_weight;
+    double h = sizes.heights[i];
+    if (!plan.map && sizes.line_weight > 0)
+      h += sizes.spare * std::max(p.height_weight, 0.0) / sizes.line_weight;
     plan.plot.y1 = y - plan.top, plan.plot.y0 = plan.plot.y1 - h;
     if (!p.title.empty()) {
       plan.title_box = {left, left + plan.title.widest,
@@ -352,17 +412,40 @@ FigurePlan plan_figure(const PlotFigure& f, double W, double H, double c, const 
                          plan.plot.y1};
     } else if (!plan.legend.empty()) {
       const int rows = int((plan.legend.size() + plan.legend_columns - 1) / plan.legend_columns);
-      if (legend_right) {
-        plan.legend_box = {plan.plot.x1 + c, plan.plot.x1 + c + legend_box, 0, plan.plot.y1};
+      if (col.legend_right) {
+        plan.legend_box = {plan.plot.x1 + c, plan.plot.x1 + c + col.legend_box, 0, plan.plot.y1};
       } else {
         const double top = plan.plot.y0 - 1.7 * c - (p.x_label.empty() ? 0 : 1.6 * c) - 0.6 * c;
-        plan.legend_box = {
-            left, left + plan.legend_columns * (fig.legend_entry + 1.5 * c) - 0.7 * c, 0, top};
+        plan.legend_box = {left, left + plan.legend_columns * (legend_entry + 1.5 * c) - 0.7 * c, 0,
+                           top};
       }
       plan.legend_box.y0 = plan.legend_box.y1 - rows * row - 0.4 * c;
     }
     y = plan.plot.y0 - plan.bottom - 0.8 * c;
   }
+}
+
+}  // namespace
+
+FigurePlan plan_figure(const PlotFigure& f, double W, double H, double c, const TextMeter& m,
+                       std::vector<PanelPlan> plans) {
+  FigurePlan fig;
+  const double margin = page_margin(c);
+  const LabelWidths widths = measure_labels(f, plans, m);
+  fig.legend_entry = widths.legend_text > 0 ? 3.4 * c + widths.legend_text : 0;
+  fig.y_label_x = margin + 0.5 * c;
+  const Columns col = plan_columns(f, widths, fig.legend_entry, W, c);
+  const double fixed = plan_panel_surrounds(f, col, fig.legend_entry, W, c, m, plans);
+  const double footer_height = plan_footer(f, W, c, m, fig.footer);
+  const double available = H - fixed - footer_height;
+  if (!(available >= 2.5 * c * double(plans.size()))) {
+    throw Error("the figure (" + number_label(W / kMmPerPoint) + " x " +
+                number_label(H / kMmPerPoint) + ") is too small for its " +
+                std::to_string(plans.size()) + " panels and " + std::to_string(f.footer.size()) +
+                " footer lines");
+  }
+  const PlotHeights heights = share_plot_heights(f, plans, col, available, c);
+  place_panels(f, col, heights, fig.legend_entry, H, c, plans);
   if (footer_height > 0) fig.footer_box = {margin, W - margin, margin, margin + footer_height};
   fig.panels = std::move(plans);
   return fig;

@@ -15,7 +15,7 @@ mkdir -p "$work"
 mode="${MODE:-accuracy}"
 csv="${CSV:-$here/render_$mode.csv}"
 lights=(--light directional:1,0.5,0.5:1,1,1 --light point:-60,60,80:5000,5000,5000)
-common=(--size 64x64 --threads 2 --specular off "${lights[@]}")
+common=(--size 64x64 --reference-threads 2 --specular off "${lights[@]}")
 reference_probes=8192
 tmp="$csv.tmp"
 echo "setting,mesh,material,model,frames,relative_rmse,mean_ratio_r,mean_ratio_g,mean_ratio_b,rmse_vs_final,seconds" > "$tmp"
@@ -23,7 +23,7 @@ echo "setting,mesh,material,model,frames,relative_rmse,mean_ratio_r,mean_ratio_g
 reference() {  # mesh material model -> path
   local out="$work/ref_${1/:/_}_$2_$3.exr"
   if [[ ! -f "$out" ]]; then
-    "$lucent" render --technique reference --samples-pixel $reference_probes --seed 7 \
+    "$lucent" render --technique reference --reference-samples-pixel $reference_probes --seed 7 \
       --material "$2" --mesh "$1" --model "$3" "${common[@]}" -o "$out" >/dev/null 2>&1
   fi
   echo "$out"
@@ -38,7 +38,7 @@ run_case() {  # setting mesh material model frames snapshots... -- map options
   local start end
   start=$(date +%s.%N)
   "$lucent" render --material "$material" --mesh "$mesh" --model "$model" "${common[@]}" \
-    --frames "$frames" --snapshots "$snaps" "$@" -o "$out" >/dev/null 2>&1
+    --maps-frames "$frames" --snapshots "$snaps" "$@" -o "$out" >/dev/null 2>&1
   end=$(date +%s.%N)
   for t in ${snaps//,/ }; do
     local img="${out%.exr}.f$t.exr"
@@ -57,7 +57,7 @@ PY
   echo "done: $setting $mesh $material $model" >&2
 }
 
-light=(--directions 8 --radiance-map 256 --light-map 256 --samples 32 --disc-points 256)
+light=(--maps-directions 8 --maps-radiance-map 256 --maps-light-map 256 --maps-samples 32 --maps-disc-points 256)
 if [[ "$mode" == accuracy ]]; then
   for mesh in ${MESHES:-sphere dragon:4}; do
     for material in marble potato skin1; do

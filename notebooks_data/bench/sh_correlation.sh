@@ -15,8 +15,8 @@ for mesh in bunny sphere; do
       [ "$mesh" = sphere ] && [ "$mat" = potato ] && continue
       tag=${mesh}_${name}_${mat}
       common="--material $mat --mesh $mesh --size 64x64 --light directional:$dir:3,3,3 --specular off"
-      [ -f "$W/ref_$tag.exr" ] || "$L" render --technique reference --samples-pixel 2048 \
-        --threads 2 $common -o "$W/ref_$tag.exr" >/dev/null
+      [ -f "$W/ref_$tag.exr" ] || "$L" render --technique reference --reference-samples-pixel 2048 \
+        --reference-threads 2 $common -o "$W/ref_$tag.exr" >/dev/null
       "$L" render --technique sh $common -o "$W/sh_$tag.exr" >/dev/null
       echo "$tag $("$L" compare "$W/sh_$tag.exr" "$W/ref_$tag.exr" --fit-scale | grep -i correl)"
     done

@@ -298,7 +298,8 @@ class SceneBench {
 
   // Two frames: the first builds the hierarchy and the links (and compiles the programs), the
   // second is the steady state of the render mode (links kept, the solve and the draw redone).
-  void run_hierarchical(const std::string& name, const hbe::Options& o, const Scene& scene) {
+  void run_hierarchical(const std::string& name, const hierarchical::Options& o,
+                        const Scene& scene) {
     o.validate();
     const auto context = GlContext::create_headless();
     HierarchicalRenderer renderer;
@@ -310,7 +311,7 @@ class SceneBench {
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     renderer.render_frame();
     const ImageRgb image = renderer.read_image();
-    const hbe::Stats& s = renderer.stats();
+    const hierarchical::Stats& s = renderer.stats();
     TradeoffRow r = row(technique_info(TechniqueId::kHierarchical).name, DiffusionModel::kDipole,
                         name, image, scene.mesh);
     r.frame_ms = s.irradiance_ms + s.pull_ms + s.gather_ms + s.push_ms + renderer.upload_ms() +
@@ -320,14 +321,14 @@ class SceneBench {
   }
 
   void run_hierarchical_sweep(TradeoffSweep sweep) {
-    const hbe::Options base;
-    auto named = [](const hbe::Options& o) {
+    const hierarchical::Options base;
+    auto named = [](const hierarchical::Options& o) {
       std::ostringstream s;
       s << "eps1 " << o.epsilon_1 << " eps2 " << o.epsilon_2 << " c " << o.form_factor.edge_constant;
       return s.str();
     };
-    std::vector<hbe::Options> variants;
-    hbe::Options coarse = base;
+    std::vector<hierarchical::Options> variants;
+    hierarchical::Options coarse = base;
     coarse.epsilon_1 = 0.2, coarse.epsilon_2 = 1.6;
     if (sweep == TradeoffSweep::kTiny) {
       variants = {coarse};
@@ -336,22 +337,22 @@ class SceneBench {
     } else {
       variants = {coarse, base};
       for (double e1 : {0.2, 0.1, 0.025}) {
-        hbe::Options o = base;
+        hierarchical::Options o = base;
         o.epsilon_1 = e1;
         variants.push_back(o);
       }
       for (double e2 : {1.6, 0.8, 0.2}) {
-        hbe::Options o = base;
+        hierarchical::Options o = base;
         o.epsilon_2 = e2;
         variants.push_back(o);
       }
       for (double c : {0.8, 0.2}) {
-        hbe::Options o = base;
+        hierarchical::Options o = base;
         o.form_factor.edge_constant = c;
         variants.push_back(o);
       }
     }
-    for (const hbe::Options& o : variants) run_hierarchical(named(o), o, scene_);
+    for (const hierarchical::Options& o : variants) run_hierarchical(named(o), o, scene_);
     if (sweep == TradeoffSweep::kTiny) return;
     // The mesh's resolution (the same shape; the reference stays on the scene's mesh).
     for (const std::string& mesh : other_resolutions(spec_.mesh, sweep == TradeoffSweep::kFull)) {

@@ -1,5 +1,5 @@
-// Polygonal area lights (render/include/lucent/render/area_light.h).
-#include "lucent/render/area_light.h"
+// Polygonal area lights (render/core/area_light.h).
+#include "area_light.h"
 
 #include <algorithm>
 #include <cmath>

@@ -20,7 +20,7 @@
 
 #include <cstdint>
 
-#include "lucent/render/area_light.h"
+#include "area_light.h"
 #include "reference_common.h"
 
 namespace lucent::render::detail {

@@ -220,7 +220,16 @@ double Mesh::surface_area() const {
   return area;
 }
 
-Mesh parse_ply(std::string_view bytes, const std::string& source) {
+namespace {
+
+// A PLY header: the format, the elements with their properties, and where the body starts.
+struct PlyHeader {
+  Format format = Format::kAscii;
+  std::vector<Element> elements;
+  std::size_t body_offset = 0;
+};
+
+PlyHeader parse_ply_header(std::string_view bytes, const std::string& source) {
   // Header: lines up to "end_header".
   std::size_t pos = 0;
   auto next_line = [&]() -> std::optional<std::string_view> {
@@ -281,11 +290,83 @@ Mesh parse_ply(std::string_view bytes, const std::string& source) {
     }
   }
   if (!format) throw Error(source + ": the PLY header has no format line");
+  return {*format, std::move(elements), pos};
+}
 
-  BodyReader body(bytes.substr(pos), *format, source);
+// The vertex element: positions (finite) and, where it has nx, ny and nz, normals.
+void read_ply_vertices(BodyReader& body, const Element& e, Mesh& mesh, const std::string& source) {
+  int x = -1, y = -1, z = -1, nx = -1, ny = -1, nz = -1;
+  for (std::size_t i = 0; i < e.properties.size(); ++i) {
+    const std::string& n = e.properties[i].name;
+    if (e.properties[i].list) continue;
+    if (n == "x") x = int(i);
+    if (n == "y") y = int(i);
+    if (n == "z") z = int(i);
+    if (n == "nx") nx = int(i);
+    if (n == "ny") ny = int(i);
+    if (n == "nz") nz = int(i);
+  }
+  if (x < 0 || y < 0 || z < 0)
+    throw Error(source + ": element vertex: expected properties x, y and z");
+  const bool normals = nx >= 0 && ny >= 0 && nz >= 0;
+  mesh.positions.reserve(e.count);
+  if (normals) mesh.normals.reserve(e.count);
+  std::vector<double> values(e.properties.size());
+  for (std::uint64_t k = 0; k < e.count; ++k) {
+    const std::string where = "vertex " + std::to_string(k);
+    for (std::size_t i = 0; i < e.properties.size(); ++i) {
+      const Property& p = e.properties[i];
+      if (p.list)
+        body.skip(p, where);
+      else
+        values[i] = body.read(p.type, where);
+    }
+    const Vec3f position(static_cast<float>(values[x]), static_cast<float>(values[y]),
+                         static_cast<float>(values[z]));
+    check_finite(position, source, where);
+    mesh.positions.push_back(position);
+    if (normals) mesh.normals.emplace_back(float(values[nx]), float(values[ny]), float(values[nz]));
+  }
+}
+
+// The face element: each polygon's vertex_indices as a fan of triangles.
+void read_ply_faces(BodyReader& body, const Element& e, Mesh& mesh, const std::string& source) {
+  int indices = -1;
+  for (std::size_t i = 0; i < e.properties.size(); ++i) {
+    const Property& p = e.properties[i];
+    if (p.list && (p.name == "vertex_indices" || p.name == "vertex_index")) indices = int(i);
+  }
+  if (indices < 0) throw Error(source + ": element face: expected a list property vertex_indices");
+  if (!is_integer(e.properties[indices].type))
+    throw Error(source + ": element face: vertex_indices must have an integer type");
+  std::vector<unsigned> polygon;
+  for (std::uint64_t k = 0; k < e.count; ++k) {
+    const std::string where = "face " + std::to_string(k);
+    for (std::size_t i = 0; i < e.properties.size(); ++i) {
+      const Property& p = e.properties[i];
+      if (int(i) != indices) {
+        body.skip(p, where);
+        continue;
+      }
+      polygon.clear();
+      for (std::uint64_t j = 0, n = body.list_length(p, where); j < n; ++j) {
+        polygon.push_back(
+            vertex_index(body.read(p.type, where), mesh.positions.size(), source, where));
+      }
+      for (std::size_t j = 2; j < polygon.size(); ++j)  // a fan; points and lines add nothing
+        mesh.triangles.push_back({polygon[0], polygon[j - 1], polygon[j]});
+    }
+  }
+}
+
+}  // namespace
+
+Mesh parse_ply(std::string_view bytes, const std::string& source) {
+  const PlyHeader header = parse_ply_header(bytes, source);
+  BodyReader body(bytes.substr(header.body_offset), header.format, source);
   Mesh mesh;
   bool have_vertices = false;
-  for (const Element& e : elements) {
+  for (const Element& e : header.elements) {
     if (e.count > body.left() / body.min_item_bytes(e)) {
       throw Error(source + ": element " + e.name + ": the header declares " +
                   std::to_string(e.count) + " items, more than the file's " +
@@ -294,67 +375,10 @@ Mesh parse_ply(std::string_view bytes, const std::string& source) {
     if (e.name == "vertex") {
       if (have_vertices) throw Error(source + ": more than one vertex element");
       have_vertices = true;
-      int x = -1, y = -1, z = -1, nx = -1, ny = -1, nz = -1;
-      for (std::size_t i = 0; i < e.properties.size(); ++i) {
-        const std::string& n = e.properties[i].name;
-        if (e.properties[i].list) continue;
-        if (n == "x") x = int(i);
-        if (n == "y") y = int(i);
-        if (n == "z") z = int(i);
-        if (n == "nx") nx = int(i);
-        if (n == "ny") ny = int(i);
-        if (n == "nz") nz = int(i);
-      }
-      if (x < 0 || y < 0 || z < 0)
-        throw Error(source + ": element vertex: expected properties x, y and z");
-      const bool normals = nx >= 0 && ny >= 0 && nz >= 0;
-      mesh.positions.reserve(e.count);
-      if (normals) mesh.normals.reserve(e.count);
-      std::vector<double> values(e.properties.size());
-      for (std::uint64_t k = 0; k < e.count; ++k) {
-        const std::string where = "vertex " + std::to_string(k);
-        for (std::size_t i = 0; i < e.properties.size(); ++i) {
-          const Property& p = e.properties[i];
-          if (p.list)
-            body.skip(p, where);
-          else
-            values[i] = body.read(p.type, where);
-        }
-        const Vec3f position(static_cast<float>(values[x]), static_cast<float>(values[y]),
-                             static_cast<float>(values[z]));
-        check_finite(position, source, where);
-        mesh.positions.push_back(position);
-        if (normals) mesh.normals.emplace_back(float(values[nx]), float(values[ny]), float(values[nz]));
-      }
+      read_ply_vertices(body, e, mesh, source);
     } else if (e.name == "face") {
       if (!have_vertices) throw Error(source + ": element face comes before element vertex");
-      int indices = -1;
-      for (std::size_t i = 0; i < e.properties.size(); ++i) {
-        const Property& p = e.properties[i];
-        if (p.list && (p.name == "vertex_indices" || p.name == "vertex_index")) indices = int(i);
-      }
-      if (indices < 0)
-        throw Error(source + ": element face: expected a list property vertex_indices");
-      if (!is_integer(e.properties[indices].type))
-        throw Error(source + ": element face: vertex_indices must have an integer type");
-      std::vector<unsigned> polygon;
-      for (std::uint64_t k = 0; k < e.count; ++k) {
-        const std::string where = "face " + std::to_string(k);
-        for (std::size_t i = 0; i < e.properties.size(); ++i) {
-          const Property& p = e.properties[i];
-          if (int(i) != indices) {
-            body.skip(p, where);
-            continue;
-          }
-          polygon.clear();
-          for (std::uint64_t j = 0, n = body.list_length(p, where); j < n; ++j) {
-            polygon.push_back(vertex_index(body.read(p.type, where), mesh.positions.size(), source,
-                                           where));
-          }
-          for (std::size_t j = 2; j < polygon.size(); ++j)  // a fan; points and lines add nothing
-            mesh.triangles.push_back({polygon[0], polygon[j - 1], polygon[j]});
-        }
-      }
+      read_ply_faces(body, e, mesh, source);
     } else {
       for (std::uint64_t k = 0; k < e.count; ++k) {
         const std::string where = e.name + " " + std::to_string(k);

@@ -21,18 +21,18 @@ void require(bool ok, const std::string& option, const std::string& what, double
 
 void RenderSettings::validate() const {
   // The upper bounds keep a typo from running for days or allocating what no GPU has.
-  require(frames >= 1 && frames <= 100000, "--frames", "must be 1..100000", frames);
-  require(directions >= 1 && directions <= 256, "--directions", "must be 1..256", directions);
-  require(samples >= 1 && samples <= 65536, "--samples", "must be 1..65536", samples);
-  require(disc_points >= 1 && disc_points <= 1048576, "--disc-points", "must be 1..1048576",
+  require(frames >= 1 && frames <= 100000, "--maps-frames", "must be 1..100000", frames);
+  require(directions >= 1 && directions <= 256, "--maps-directions", "must be 1..256", directions);
+  require(samples >= 1 && samples <= 65536, "--maps-samples", "must be 1..65536", samples);
+  require(disc_points >= 1 && disc_points <= 1048576, "--maps-disc-points", "must be 1..1048576",
           disc_points);
-  require(samples <= disc_points, "--samples",
+  require(samples <= disc_points, "--maps-samples",
           "must not exceed --disc-points (" + std::to_string(disc_points) + ")", samples);
-  require(std::isfinite(q) && q > 0 && q <= 1000, "--q", "must be in (0, 1000]", q);
-  require(radiance_map_size >= 8 && radiance_map_size <= 8192, "--radiance-map",
+  require(std::isfinite(q) && q > 0 && q <= 1000, "--maps-q", "must be in (0, 1000]", q);
+  require(radiance_map_size >= 8 && radiance_map_size <= 8192, "--maps-radiance-map",
           "must be 8..8192 texels", radiance_map_size);
-  require(light_map_size >= 8 && light_map_size <= 8192, "--light-map", "must be 8..8192 texels",
-          light_map_size);
+  require(light_map_size >= 8 && light_map_size <= 8192, "--maps-light-map",
+          "must be 8..8192 texels", light_map_size);
   require(std::isfinite(exposure) && exposure > 0, "--exposure", "must be positive", exposure);
 }
 
@@ -49,7 +49,8 @@ std::string RenderSettings::to_string() const {
 DiscSelection parse_disc_selection(const std::string& text) {
   if (text == "nearest") return DiscSelection::kNearest;
   if (text == "strata") return DiscSelection::kStrata;
-  throw Error("--disc-selection: expected nearest (Dal Corso 2014) or strata, got '" + text + "'");
+  throw Error("--maps-disc-selection: expected nearest (Dal Corso 2014) or strata, got '" + text +
+              "'");
 }
 
 std::string to_string(DiscSelection selection) {
@@ -59,7 +60,7 @@ std::string to_string(DiscSelection selection) {
 DiscDistribution parse_disc_distribution(const std::string& text) {
   if (text == "profile") return DiscDistribution::kProfile;
   if (text == "exponential") return DiscDistribution::kExponential;
-  throw Error("--disc-distribution: expected profile or exponential (Dal Corso 2014), got '" +
+  throw Error("--maps-disc-distribution: expected profile or exponential (Dal Corso 2014), got '" +
               text + "'");
 }
 

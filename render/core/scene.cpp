@@ -11,8 +11,8 @@
 
 #include <Eigen/Geometry>
 
+#include "area_light.h"
 #include "lucent/core/error.h"
-#include "lucent/render/area_light.h"
 #include "lucent/render/scene.h"
 
 namespace lucent::render {

@@ -103,7 +103,8 @@ ImageRgb render_still(TechniqueId id, const Scene& scene, const TechniqueOptions
       return std::move(result.image);
     }
     case TechniqueId::kSh: return render_sh(scene, options.sh, stats);
-    case TechniqueId::kHierarchical: return render_hierarchical(scene, options.hbe, stats);
+    case TechniqueId::kHierarchical:
+      return render_hierarchical(scene, options.hierarchical, stats);
     case TechniqueId::kFur: return render_fur(scene, options.fur, stats, options.settings);
     case TechniqueId::kMaps:
       return render_radiance_maps(scene, options.settings, options.maps, stats, nullptr);
@@ -124,11 +125,15 @@ std::string FrameStats::to_string() const {
 
 std::string settings_text(TechniqueId id, const TechniqueOptions& options) {
   switch (id) {
-    case TechniqueId::kMaps: return options.settings.to_string();
+    case TechniqueId::kMaps:
+      return options.settings.to_string() + " " + options.maps.to_string();
     case TechniqueId::kSh: return options.sh.to_string();
-    case TechniqueId::kHierarchical: return options.hbe.to_string();
+    case TechniqueId::kHierarchical:
+      return options.hierarchical.to_string();
     case TechniqueId::kFur:
-    case TechniqueId::kReference: return "";
+      return options.fur.to_string();
+    case TechniqueId::kReference:
+      return options.reference.to_string();
   }
   return "";
 }

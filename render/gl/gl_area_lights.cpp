@@ -4,8 +4,8 @@
 #include <cmath>
 #include <string>
 
+#include "area_light.h"
 #include "lucent/core/error.h"
-#include "lucent/render/area_light.h"
 
 namespace lucent::render::gl {
 

@@ -38,6 +38,82 @@ void basis(const Vec3d& n, Vec3d& b1, Vec3d& b2) {
 
 constexpr int kMaxHitsPerProbe = 32;
 
+// What the lights send into the surface at a probe's hit x_f (triangle `tri`, geometric normal
+// g_f, shading normal n_f) and out at the pixel's x_o, over the probe density `pdf`: added to
+// `sum`. `key` and `n` (the hit's index along the probe) seed the area lights' points.
+struct ProbeShading {
+  const Scene& scene;
+  const ReferenceOptions& options;
+  const RayScene& rays;
+  const IrradianceCache* cache;
+  const std::array<ChannelBssrdf, 3>& bssrdf;
+  bool per_light;
+  AreaLightSampling area_sampling;
+  float eps;
+  double eta;
+};
+
+void add_hit(const ProbeShading& ps, unsigned tri, const Vec3f& x_f, const Vec3f& g_f,
+             const Vec3f& n_f, const Vec3d& x_o, const Vec3d& n_o, double pdf, std::uint64_t key,
+             int n, std::array<double, 3>& sum) {
+  const Scene& scene = ps.scene;
+  const ReferenceOptions& options = ps.options;
+  const RayScene& rays = ps.rays;
+  const IrradianceCache* cache = ps.cache;
+  const std::array<ChannelBssrdf, 3>& bssrdf = ps.bssrdf;
+  const bool per_light = ps.per_light;
+  const AreaLightSampling& area_sampling = ps.area_sampling;
+  const float eps = ps.eps;
+  const double eta = ps.eta;
+  const Vec3d x_i = x_f.cast<double>(), n_i = n_f.cast<double>();
+  std::array<double, 3> radial{0, 0, 0};
+  if (!per_light) {
+    for (int c = 0; c < 3; ++c) radial[c] = bssrdf[c](x_i, n_i, n_i, x_o, n_o);
+  }
+  if (cache) {
+    Vec3f w_cache;
+    const auto E = cache->lookup(tri, x_f, &w_cache);
+    const Vec3d w_i = w_cache.cast<double>();
+    for (int c = 0; c < 3; ++c) {
+      const double s_d = per_light ? bssrdf[c](x_i, n_i, w_i, x_o, n_o) : radial[c];
+      sum[c] += E[std::size_t(c)] / pdf * s_d;
+    }
+  }
+  for (std::size_t l = 0; l < scene.lights.size(); ++l) {
+    const Light& light = scene.lights[l];
+    if (light.type == LightType::kArea) {
+      if (cache) continue;
+      const AreaIrradiance a =
+          area_light_irradiance(light, x_f, n_f, g_f, &rays, eps, eta, area_sampling,
+                                mix(key ^ (0xA2EAull + std::uint64_t(n) * 0x100000001B3ull + l)));
+      if (a.transmitted == 0) continue;
+      const Vec3d w_i = a.w.cast<double>();
+      const double factor = a.transmitted / pdf;
+      for (int c = 0; c < 3; ++c) {
+        const double s_d = per_light ? bssrdf[c](x_i, n_i, w_i, x_o, n_o) : radial[c];
+        sum[c] += factor * light.radiance[c] * s_d;
+      }
+      continue;
+    }
+    Vec3f w;
+    double scale = 1, distance = kInf;
+    if (!toward_light(light, x_f, w, scale, distance)) continue;
+    const double cos_i = n_f.dot(w);
+    if (!(cos_i > 0)) continue;
+    if (options.shadows) {
+      const Vec3f off = g_f.dot(w) >= 0 ? g_f : Vec3f(-g_f);
+      if (rays.occluded(x_f + eps * off, w, distance - eps)) continue;
+    }
+    const double factor = scale * cos_i * materials::fresnel_transmittance(cos_i, eta) *
+                          (scene.fur_coat ? scene.fur_coat->at(cos_i) : 1.0) / pdf;
+    const Vec3d w_i = w.cast<double>();
+    for (int c = 0; c < 3; ++c) {
+      const double s_d = per_light ? bssrdf[c](x_i, n_i, w_i, x_o, n_o) : radial[c];
+      sum[c] += factor * light.radiance[c] * s_d;
+    }
+  }
+}
+
 }  // namespace
 
 void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions& options,
@@ -62,6 +138,8 @@ void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions
   const std::uint64_t pass_key =
       mix(options.seed * 0xD1B54A32D192ED03ull + std::uint64_t(pass) * 0x9E3779B97F4A7C15ull);
   std::atomic<std::uint64_t> total_hits{0};
+  const ProbeShading shading{scene,     options,       rays, cache, bssrdf,
+                             per_light, area_sampling, eps,  eta};
 
   parallel_for(
       object_pixels.size(), threads, 8,
@@ -115,8 +193,7 @@ void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions
               const Vec3f n_f =
                   (b0 * mesh.normals[f[0]] + bu * mesh.normals[f[1]] + bv * mesh.normals[f[2]])
                       .normalized();
-              const Vec3d x_i = x_f.cast<double>(), g_i = g_f.cast<double>(),
-                          n_i = n_f.cast<double>();
+              const Vec3d x_i = x_f.cast<double>(), g_i = g_f.cast<double>();
               const Vec3d offset = x_i - x_o;
               double pdf = 0;
               for (int b = 0; b < 3; ++b) {
@@ -141,52 +218,7 @@ void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions
               pdf *= survival;
               ++local_hits;
 
-              std::array<double, 3> radial{0, 0, 0};
-              if (!per_light) {
-                for (int c = 0; c < 3; ++c) radial[c] = bssrdf[c](x_i, n_i, n_i, x_o, n_o);
-              }
-              if (cache) {
-                Vec3f w_cache;
-                const auto E = cache->lookup(tri, x_f, &w_cache);
-                const Vec3d w_i = w_cache.cast<double>();
-                for (int c = 0; c < 3; ++c) {
-                  const double s_d = per_light ? bssrdf[c](x_i, n_i, w_i, x_o, n_o) : radial[c];
-                  sum[c] += E[std::size_t(c)] / pdf * s_d;
-                }
-              }
-              for (std::size_t l = 0; l < scene.lights.size(); ++l) {
-                const Light& light = scene.lights[l];
-                if (light.type == LightType::kArea) {
-                  if (cache) continue;
-                  const AreaIrradiance a = area_light_irradiance(
-                      light, x_f, n_f, g_f, &rays, eps, eta, area_sampling,
-                      mix(key ^ (0xA2EAull + std::uint64_t(n) * 0x100000001B3ull + l)));
-                  if (a.transmitted == 0) continue;
-                  const Vec3d w_i = a.w.cast<double>();
-                  const double factor = a.transmitted / pdf;
-                  for (int c = 0; c < 3; ++c) {
-                    const double s_d = per_light ? bssrdf[c](x_i, n_i, w_i, x_o, n_o) : radial[c];
-                    sum[c] += factor * light.radiance[c] * s_d;
-                  }
-                  continue;
-                }
-                Vec3f w;
-                double scale = 1, distance = kInf;
-                if (!toward_light(light, x_f, w, scale, distance)) continue;
-                const double cos_i = n_f.dot(w);
-                if (!(cos_i > 0)) continue;
-                if (options.shadows) {
-                  const Vec3f off = g_f.dot(w) >= 0 ? g_f : Vec3f(-g_f);
-                  if (rays.occluded(x_f + eps * off, w, distance - eps)) continue;
-                }
-                const double factor = scale * cos_i * materials::fresnel_transmittance(cos_i, eta) *
-                                      (scene.fur_coat ? scene.fur_coat->at(cos_i) : 1.0) / pdf;
-                const Vec3d w_i = w.cast<double>();
-                for (int c = 0; c < 3; ++c) {
-                  const double s_d = per_light ? bssrdf[c](x_i, n_i, w_i, x_o, n_o) : radial[c];
-                  sum[c] += factor * light.radiance[c] * s_d;
-                }
-              }
+              add_hit(shading, tri, x_f, g_f, n_f, x_o, n_o, pdf, key, n, sum);
             }
           }
           for (int c = 0; c < 3; ++c) accumulated[i][c] += sum[c] / S;

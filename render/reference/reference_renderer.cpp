@@ -572,15 +572,7 @@ ReferenceImage render_reference(const Scene& scene, DiffusionModel model,
     throw Error("reference renderer: the image must be at least 1x1 pixels, got " +
                 std::to_string(camera.width) + "x" + std::to_string(camera.height));
   }
-  if (options.pixel_samples < 1) {
-    throw Error("--samples-pixel: must be at least 1, got " +
-                std::to_string(options.pixel_samples));
-  }
-  if (options.surface_samples < 1) {
-    throw Error("--samples-reference: must be at least 1, got " +
-                std::to_string(options.surface_samples));
-  }
-  if (options.passes < 1) throw Error("reference renderer: passes must be at least 1");
+  options.validate();
   if (mesh.triangles.empty() || mesh.normals.size() != mesh.positions.size()) {
     throw Error("reference renderer: mesh '" + mesh.name + "' has no triangles or no normals");
   }

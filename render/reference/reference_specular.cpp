@@ -1,7 +1,7 @@
 // The CPU reference's specular term (reference_renderer.h): every light's GGX lobe at a pixel's
 // point (materials/specular.h) with shadow rays; area lights by stratified points on the polygon.
+#include "area_light.h"
 #include "lucent/materials/specular.h"
-#include "lucent/render/area_light.h"
 #include "reference_common.h"
 
 namespace lucent::render::detail {

@@ -2,7 +2,7 @@
 // renderer drawing into it, Dear ImGui's panel on top, and the CPU reference on a worker thread.
 #include "lucent/render/viewer.h"
 
-#include "lucent/render/area_light.h"
+#include "area_light.h"
 #include "viewer_impl.h"
 
 #include "lucent/core/atomic_file.h"
@@ -299,9 +299,19 @@ void Viewer::rebuild_maps() {
   }
 }
 
-void Viewer::set_parameter(const std::string& name, const std::string& value) {
+// The script's `set NAME VALUE`: NAME is the CLI's flag without its dashes (maps-samples,
+// maps-disc-selection, object-size-mm, ...); the panel's short names (N, M, q, K, Ws, Wl, T, disc,
+// size) are kept as aliases.
+void Viewer::set_parameter(const std::string& given, const std::string& value) {
+  static const std::vector<std::pair<std::string, std::string>> kShort = {
+      {"N", "maps-samples"},    {"M", "maps-disc-points"},       {"q", "maps-q"},
+      {"K", "maps-directions"}, {"Ws", "maps-radiance-map"},     {"Wl", "maps-light-map"},
+      {"T", "maps-frames"},     {"disc", "maps-disc-selection"}, {"size", "object-size-mm"}};
+  std::string name = given;
+  for (const auto& [alias, cli] : kShort)
+    if (given == alias) name = cli;
   if (name == "technique") return set_technique(value);
-  if (name == "disc") {
+  if (name == "maps-disc-selection") {
     settings_.disc_selection = pending_.disc_selection = parse_disc_selection(value);
     return rebuild_maps();  // the reference does not use the disc
   }
@@ -312,36 +322,37 @@ void Viewer::set_parameter(const std::string& name, const std::string& value) {
     rebuild_maps();
     return scene_changed();  // the reference uses the model too
   }
-  const float v = parse_float(value, "set " + name);
+  const float v = parse_float(value, "set " + given);
   if (name == "exposure") {
     settings_.exposure = pending_.exposure = v;
   } else if (name == "light_scale") {
     scale_selected_light(v);
-  } else if (name == "size") {
+  } else if (name == "object-size-mm") {
     set_object_size(v);
   } else if (name == "deform") {
     set_deform(v);
   } else {
     RenderSettings next = settings_;
-    if (name == "N")
+    if (name == "maps-samples")
       next.samples = int(v);
-    else if (name == "M")
+    else if (name == "maps-disc-points")
       next.disc_points = int(v);
-    else if (name == "q")
+    else if (name == "maps-q")
       next.q = v;
-    else if (name == "K")
+    else if (name == "maps-directions")
       next.directions = int(v);
-    else if (name == "Ws")
+    else if (name == "maps-radiance-map")
       next.radiance_map_size = int(v);
-    else if (name == "Wl")
+    else if (name == "maps-light-map")
       next.light_map_size = int(v);
-    else if (name == "T")
+    else if (name == "maps-frames")
       next.frames = int(v);
     else
-      throw Error(
-          "--script: set " + name +
-          ": expected N, M, q, K, Ws, Wl, T, exposure, size, deform, light_scale, disc, technique or "
-          "model");
+      throw Error("--script: set " + given +
+                  ": expected maps-samples, maps-disc-points, maps-q, maps-directions, "
+                  "maps-radiance-map, maps-light-map, maps-frames, maps-disc-selection, technique, "
+                  "model, exposure, object-size-mm, deform or light_scale (or the panel's N, M, q, "
+                  "K, Ws, Wl, T, disc, size)");
     next.validate();
     settings_ = pending_ = next;
     rebuild_maps();

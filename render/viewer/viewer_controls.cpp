@@ -6,7 +6,7 @@
 #include <numbers>
 #include <system_error>
 #include <utility>
-#include "lucent/render/area_light.h"
+#include "area_light.h"
 
 namespace lucent::render {
 namespace {

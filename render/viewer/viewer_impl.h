@@ -193,7 +193,11 @@ class Viewer {
   void handle_mouse();
   void handle_keys();
   void run_script_step();
-  void draw_ui();
+  void draw_ui();              // the panel: the four below in order
+  void draw_choices();         // material, technique, model, material controls
+  void draw_maps_knobs();      // the radiance maps' speed/accuracy knobs
+  void draw_scene_controls();  // exposure, object size, deformer, lights
+  void draw_progress();        // statistics, the difference view
   void draw_reference();
   // One frame of the current frame-by-frame technique (made and brought up to date first), on
   // screen or in the difference view; one that fails says why and hands over to the maps.

@@ -1,6 +1,6 @@
 // The viewer's panel (Dear ImGui): material, model and technique, the radiance maps' knobs, the
 // scene, progress and the difference against the reference (viewer_impl.h).
-#include "lucent/render/area_light.h"
+#include "area_light.h"
 #include "viewer_impl.h"
 
 namespace lucent::render::viewer_detail {
@@ -28,6 +28,19 @@ void Viewer::draw_ui() {
   ImGui::Begin("lucent", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
   ImGui::PushItemWidth(120 * scale);
 
+  draw_choices();
+  draw_maps_knobs();
+  draw_scene_controls();
+  draw_progress();
+  if (!message_.empty()) ImGui::TextWrapped("%s", message_.c_str());
+  ImGui::TextDisabled("drag: orbit  right drag: light  wheel: zoom");
+  ImGui::TextDisabled("S screenshot  R restart  H hide  D difference  Esc quit");
+  ImGui::PopItemWidth();
+  ImGui::End();
+}
+
+// Material (the library or a file), technique and model, and the material's own controls.
+void Viewer::draw_choices() {
   // Material: the library, or a file (reloaded when it changes on disk).
   if (ImGui::BeginCombo("material", scene_.material.name.c_str())) {
     for (const std::string& name : materials::library_material_names()) {
@@ -67,8 +80,10 @@ void Viewer::draw_ui() {
   if (ImGui::CollapsingHeader("material", ImGuiTreeNodeFlags_DefaultOpen)) {
     draw_material_controls();
   }
+}
 
-  // The speed/accuracy knobs: applied when a slider is let go (they rebuild the maps).
+// The speed/accuracy knobs: applied when a slider is let go (they rebuild the maps).
+void Viewer::draw_maps_knobs() {
   if (ImGui::CollapsingHeader("radiance maps")) {
   bool apply = false;
   int disc = pending_.disc_selection == DiscSelection::kStrata ? 0 : 1;
@@ -110,6 +125,10 @@ void Viewer::draw_ui() {
   }
 
   }
+}
+
+// Exposure, object size, the deformer and the dragged light.
+void Viewer::draw_scene_controls() {
   if (ImGui::CollapsingHeader("scene")) {
   ImGui::SliderFloat("exposure", &settings_.exposure, 0.01f, 100.0f, "%.3g",
                      ImGuiSliderFlags_Logarithmic);
@@ -134,6 +153,11 @@ void Viewer::draw_ui() {
   if (technique_ == TechniqueId::kReference && deformer_)
     ImGui::TextUnformatted("(the deformer pauses for the reference)");
   }
+}
+
+// The current technique's statistics (FrameStats) or the reference's passes, and the difference
+// view's numbers.
+void Viewer::draw_progress() {
   section("progress");
   if (const Technique* t = live(technique_)) {
     // Every frame-by-frame technique's statistics in the one form of FrameStats.
@@ -159,11 +183,6 @@ void Viewer::draw_ui() {
     ImGui::Checkbox("difference vs reference (D)", &show_difference_);
     if (show_difference_) ImGui::TextWrapped("%s", difference_text_.c_str());
   }
-  if (!message_.empty()) ImGui::TextWrapped("%s", message_.c_str());
-  ImGui::TextDisabled("drag: orbit  right drag: light  wheel: zoom");
-  ImGui::TextDisabled("S screenshot  R restart  H hide  D difference  Esc quit");
-  ImGui::PopItemWidth();
-  ImGui::End();
 }
 
 // Per channel: the mean free path 1 / sigma_t' (mm) and the reduced albedo alpha'; and eta, g.

@@ -22,7 +22,7 @@ TechniqueOptions Viewer::technique_options() const {
   o.settings = settings_;
   o.maps.time_stages = true;  // the panel shows the passes' times
   o.sh = options_.sh;
-  o.hbe = options_.hbe;
+  o.hierarchical = options_.hierarchical;
   o.fur = options_.fur;
   o.reference = options_.reference;
   return o;

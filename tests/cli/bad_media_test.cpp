@@ -209,7 +209,7 @@ std::vector<BadCase> image_cases() {
   const std::string cmp = "compare {dir}/a.exr {world}/env.exr --json";
   const std::string env =
       "render --material marble --mesh sphere --technique reference --size 8x8 "
-      "--samples-pixel 1 -o {dir}/out.exr --env ";
+      "--reference-samples-pixel 1 -o {dir}/out.exr --env ";
   return {
       {"exr_missing", nullptr, cmp, "a.exr"},
       {"exr_text", bytes_file("a.exr", "hello"), cmp, "a.exr"},
@@ -240,7 +240,7 @@ std::vector<BadCase> image_cases() {
       {"env_overwritten_by_output",
        [](const fs::path& d) { fs::copy_file(world() / "env.exr", d / "e.exr"); },
        "render --material marble --mesh sphere --technique reference --size 8x8 "
-       "--samples-pixel 1 --env {dir}/e.exr -o {dir}/e.exr",
+       "--reference-samples-pixel 1 --env {dir}/e.exr -o {dir}/e.exr",
        "is an input"},
       {"exr_reference_missing",
        [](const fs::path& d) { fs::copy_file(world() / "env.exr", d / "a.exr"); },
@@ -280,7 +280,7 @@ std::vector<BadCase> image_cases() {
 std::vector<BadCase> mesh_cases() {
   const std::string pre =
       "render --material marble --technique reference --size 8x8 "
-      "--samples-pixel 1 -o {dir}/out.exr --mesh ";
+      "--reference-samples-pixel 1 -o {dir}/out.exr --mesh ";
   const auto from_world = [](std::string seed, std::string name,
                              std::function<std::string(std::string)> edit) {
     return [=](const fs::path& d) { write_file(d / name, edit(read_bytes(world() / seed))); };

@@ -15,8 +15,9 @@ namespace {
 
 std::vector<BadCase> option_cases() {
   const std::string sim = "simulate --material marble --photons 1000 --size 16 -o {dir}/s ";
-  const std::string ren = "render --material marble --mesh sphere --technique reference "
-                          "--size 8x8 --samples-pixel 1 -o {dir}/r.exr ";
+  const std::string ren =
+      "render --material marble --mesh sphere --technique reference "
+      "--size 8x8 --reference-samples-pixel 1 -o {dir}/r.exr ";
   const std::string fit = "fit {world}/acq/profile.json -o {dir}/m.json ";
   const std::string acq = "acquire {world}/cap/capture.json -o {dir}/a ";
   const std::string pro = "profile --material marble -o {dir}/p.csv ";
@@ -54,7 +55,7 @@ std::vector<BadCase> option_cases() {
        },
        sim, "--force"},
       // render / view scene options
-      {"render_threads_negative", nullptr, ren + "--threads -1", "--threads"},
+      {"render_threads_negative", nullptr, ren + "--reference-threads -1", "--reference-threads"},
       {"render_seed_word", nullptr, ren + "--seed abc", "--seed"},
       {"render_view_far", nullptr, ren + "--view 0,0,1e20", "--view"},
       {"render_view_two_numbers", nullptr, ren + "--view 0,0", "--view"},
@@ -68,16 +69,16 @@ std::vector<BadCase> option_cases() {
       {"render_light_kind", nullptr, ren + "--light spot:0,1,0:1,1,1", "--light"},
       {"render_light_1e38", nullptr, ren + "--light directional:0,1,0:1e38,1,1", "--light"},
       {"render_light_far", nullptr, ren + "--light point:1e30,0,0:1,1,1", "--light"},
-      {"render_light_zero_direction", nullptr, ren + "--light directional:0,0,0:1,1,1",
-       "--light"},
+      {"render_light_zero_direction", nullptr, ren + "--light directional:0,0,0:1,1,1", "--light"},
       {"render_backdrop_negative", nullptr, ren + "--backdrop -1,0,0", "--backdrop"},
       {"render_exposure_zero", nullptr, ren + "--exposure 0", "--exposure"},
       {"render_roughness_two", nullptr, ren + "--roughness 2", "--roughness"},
       {"render_technique_foo", nullptr, ren + "--technique foo", "--technique"},
       {"render_model_foo", nullptr, ren + "--model foo", "--model"},
       {"render_sampling_foo", nullptr, ren + "--reference-sampling foo", "--reference-sampling"},
-      {"render_samples_zero", nullptr, ren + "--samples-pixel 0", "--samples-pixel"},
-      {"render_passes_zero", nullptr, ren + "--passes 0", "--passes"},
+      {"render_samples_zero", nullptr, ren + "--reference-samples-pixel 0",
+       "--reference-samples-pixel"},
+      {"render_passes_zero", nullptr, ren + "--reference-passes 0", "--reference-passes"},
       {"render_stats_folder_missing", nullptr, ren + "--stats {dir}/nodir/s.json", "nodir"},
       {"render_output_folder_missing", nullptr,
        ren.substr(0, ren.find("-o ")) + "-o {dir}/nodir/r.exr", "nodir"},
@@ -89,8 +90,8 @@ std::vector<BadCase> option_cases() {
       {"fit_shard_without_batch", nullptr, fit + "--shard 0/2", "--shard"},
       {"fit_batch_shard_out_of_range", nullptr,
        "fit --batch {world}/acq/profile.json --shard 2/2 -o {dir}/s.json", "--shard"},
-      {"fit_batch_not_a_manifest", nullptr,
-       "fit --batch {world}/acq/profile.json -o {dir}/s.json", "column"},
+      {"fit_batch_not_a_manifest", nullptr, "fit --batch {world}/acq/profile.json -o {dir}/s.json",
+       "column"},
       {"fit_ior_five", nullptr, fit + "--ior 5", "--ior"},
       {"fit_g_0995", nullptr, fit + "--g 0.995", "--g"},
       {"fit_loss_trailing_garbage", nullptr, fit + "--loss huber:1abc", "--loss"},
@@ -106,7 +107,7 @@ std::vector<BadCase> option_cases() {
       // a warning of the work (dragon:4's non-manifold edges) does not join the error line
       {"render_dragon_bad_env", nullptr,
        "render --material marble --mesh dragon:4 --technique reference --size 8x8 "
-       "--samples-pixel 1 --env {dir}/none.exr -o {dir}/r.exr",
+       "--reference-samples-pixel 1 --env {dir}/none.exr -o {dir}/r.exr",
        "none.exr"},
       // acquire
       {"acquire_bins_zero", nullptr, acq + "--bins 0", "--bins"},
@@ -129,11 +130,12 @@ std::vector<BadCase> option_cases() {
       // long jobs refuse before they start
       {"bench_render_folder_missing", nullptr, "bench render --out {dir}/nodir/r.csv", "nodir"},
       {"bench_fit_folder_missing", nullptr, "bench fit --out-dir {dir}/nodir", "nodir"},
-      {"render_frames_huge", nullptr, "render --material marble --size 8x8 -o {dir}/r.exr --frames 1000000000",
-       "--frames"},
+      {"render_frames_huge", nullptr,
+       "render --material marble --size 8x8 -o {dir}/r.exr --maps-frames 1000000000",
+       "--maps-frames"},
       {"render_disc_points_huge", nullptr,
-       "render --material marble --size 8x8 -o {dir}/r.exr --disc-points 100000000",
-       "--disc-points"},
+       "render --material marble --size 8x8 -o {dir}/r.exr --maps-disc-points 100000000",
+       "--maps-disc-points"},
       {"tabulate_eta_low", nullptr, tab + "--eta 0.5", "--eta"},
       {"tabulate_incidence_89", nullptr, tab + "--incidence-deg 89", "--incidence-deg"},
       {"tabulate_incidence_decreasing", nullptr, tab + "--incidence-deg 40,30", "--incidence-deg"},
@@ -141,7 +143,8 @@ std::vector<BadCase> option_cases() {
       {"tabulate_white_photons_over", nullptr, tab + "--white-photons 5000", "--white-photons"},
       {"tabulate_g_099_5", nullptr, tab + "--g 0.995", "--g"},
       // export
-      {"export_to_blender", nullptr, "export --material marble --to blender -o {dir}/m.blend", "--to"},
+      {"export_to_blender", nullptr, "export --material marble --to blender -o {dir}/m.blend",
+       "--to"},
       {"export_unit_inch", nullptr,
        "export --material marble --to pbrt --scene-unit inch -o {dir}/m.pbrt", "--scene-unit"},
       {"export_gltf_in_cm", nullptr,

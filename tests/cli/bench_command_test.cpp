@@ -15,9 +15,10 @@ namespace fs = std::filesystem;
 TEST(BenchCommand, RenderWritesOneRowOfStageTimesPerMesh) {
   const fs::path dir = scratch_dir("bench-render");
   const fs::path csv = dir / "render.csv";
-  const auto r = run_lucent("bench render --meshes sphere --frames 1 --size 32 --radiance-map 32 "
-                            "--light-map 32 --directions 2 --samples 4 --disc-points 64 --out \"" +
-                            csv.string() + "\"");
+  const auto r = run_lucent(
+      "bench render --meshes sphere --frames 1 --size 32 --maps-radiance-map 32 "
+      "--maps-light-map 32 --maps-directions 2 --maps-samples 4 --maps-disc-points 64 --out \"" +
+      csv.string() + "\"");
   if (r.exit_code != 0 && r.err.find("EGL") != std::string::npos) GTEST_SKIP() << r.err;
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string text = read_text(csv);
@@ -30,9 +31,10 @@ TEST(BenchCommand, RenderWritesOneRowOfStageTimesPerMesh) {
 TEST(BenchCommand, BadSettingIsOneLineAndNoFile) {
   const fs::path dir = scratch_dir("bench-render-bad");
   const fs::path csv = dir / "render.csv";
-  const auto r = run_lucent("bench render --meshes sphere --directions 0 --out \"" + csv.string() + "\"");
+  const auto r =
+      run_lucent("bench render --meshes sphere --maps-directions 0 --out \"" + csv.string() + "\"");
   EXPECT_NE(r.exit_code, 0);
-  EXPECT_NE(r.err.find("--directions"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--maps-directions"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(csv));
   fs::remove_all(dir);
 }

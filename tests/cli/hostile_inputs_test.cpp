@@ -428,7 +428,7 @@ std::vector<BadCase> smaller_cases() {
   const std::string profile = "profile --material marble --r 1 -o ";
   const std::string fit = "fit {world}/acq/profile.json --quality fast -q -o ";
   const std::string render =
-      "render --material marble --technique reference --size 8x8 --samples-pixel 1 ";
+      "render --material marble --technique reference --size 8x8 --reference-samples-pixel 1 ";
   const auto fifo = [](std::string name) {
     return [=](const fs::path& d) { make_fifo(d / name); };
   };

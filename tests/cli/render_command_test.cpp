@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 
 // A tiny, fast reference render; append the case's own options.
 const std::string kTiny =
-    "render --technique reference --size 24x20 --samples-pixel 64 --threads 2 "
+    "render --technique reference --size 24x20 --reference-samples-pixel 64 --reference-threads 2 "
     "--view 30,20,4 ";
 
 void write_text(const fs::path& path, const std::string& text) {
@@ -177,10 +177,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"bad_technique",
                 "--material marble --light directional:0,0,1:1,1,1 --technique raytrace",
                 "--technique"},
-        BadCase{
-            "bad_maps_setting",
-            "--material marble --light directional:0,0,1:1,1,1 --samples 2000 --disc-points 1000",
-            "--samples"}),
+        BadCase{"bad_maps_setting",
+                "--material marble --light directional:0,0,1:1,1,1 --maps-samples 2000 "
+                "--maps-disc-points 1000",
+                "--maps-samples"}),
     [](const ::testing::TestParamInfo<BadCase>& info) { return std::string(info.param.name); });
 
 TEST(RenderCommand, UnsupportedOutputFormatFails) {
@@ -231,8 +231,10 @@ TEST(RenderCommand, SnapshotsAndCompare) {
   const auto dir = scratch_dir("render-snapshots");
   const fs::path out = dir / "maps.exr";
   auto r = run_lucent(
-      "render --material marble --mesh sphere --size 24x24 --frames 8 --directions 4 --samples 8 "
-      "--disc-points 64 --radiance-map 32 --light-map 32 --light directional:1,0,1:1,1,1 "
+      "render --material marble --mesh sphere --size 24x24 --maps-frames 8 --maps-directions 4 "
+      "--maps-samples 8 "
+      "--maps-disc-points 64 --maps-radiance-map 32 --maps-light-map 32 --light "
+      "directional:1,0,1:1,1,1 "
       "--snapshots 1,4,8 -o \"" +
           out.string() + "\"",
       "snapshots");

@@ -25,8 +25,10 @@ bool have_xvfb() {
 
 // Tiny settings: llvmpipe renders a 64-texel, 8-direction frame in ~0.1 s.
 const std::string kTiny =
-    " --mesh sphere --size 200x150 --frames 8 --directions 8 --samples 8 --disc-points 32"
-    " --radiance-map 64 --light-map 64 --samples-pixel 32 --threads 2";
+    " --mesh sphere --size 200x150 --maps-frames 8 --maps-directions 8 --maps-samples 8 "
+    "--maps-disc-points 32"
+    " --maps-radiance-map 64 --maps-light-map 64 --reference-samples-pixel 32 --reference-threads "
+    "2";
 
 struct Shot {
   imaging::RawImage image;
@@ -126,6 +128,19 @@ TEST_F(ViewCommand, ScriptOrbitsMovesTheLightAndSavesScreenshots) {
   EXPECT_LT(differing_pixels(c, d), 20);
   EXPECT_GT(differing_pixels(d, e), 300);
   EXPECT_NE(r.out.find("accumulated 8 of 8"), std::string::npos) << r.out;
+}
+
+// The script's `set` takes the CLI's flag names (and the panel's short ones): T becomes 4, N 4.
+TEST_F(ViewCommand, ScriptSetsKnobsByTheirFlagNames) {
+  CommandResult r = view("--material marble --light directional:1,0.3,0.5:1,1,1" + kTiny +
+                         " --script 'set maps-frames 4; set maps-samples 4; set N 6; set "
+                         "maps-disc-selection nearest; settle; quit'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("accumulated 4 of 4"), std::string::npos) << r.out;
+  r = view("--material marble --light directional:1,0.3,0.5:1,1,1" + kTiny +
+           " --script 'set maps-bogus 4; quit'");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("set maps-bogus: expected maps-samples"), std::string::npos) << r.err;
 }
 
 TEST_F(ViewCommand, ReloadsAnEditedMaterialDeformsAndShowsTheReference) {

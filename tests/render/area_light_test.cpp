@@ -26,20 +26,20 @@
 #include <string>
 #include <vector>
 
+#include "area_light.h"
 #include "gl_api.h"
+#include "gl_fixture.h"
 #include "gl_program.h"
 #include "lucent/materials/fresnel.h"
 #include "lucent/materials/profile_table.h"
-#include "lucent/render/area_light.h"
 #include "lucent/render/gl_context.h"
 #include "lucent/render/hierarchical_renderer.h"
 #include "lucent/render/image_compare.h"
-#include "lucent/render/polygon_form_factor.h"
 #include "lucent/render/radiance_maps.h"
 #include "lucent/render/reference_renderer.h"
 #include "lucent/render/tone_map.h"
+#include "polygon_form_factor.h"
 #include "slab_scene.h"
-#include "gl_fixture.h"
 
 namespace lucent::render {
 namespace {

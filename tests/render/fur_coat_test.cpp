@@ -203,8 +203,8 @@ TEST_F(FurCoatGlTest, RadianceMapsMatchTheClosedFormThroughTheCoat) {
   }
 }
 
-// The maps' and the hierarchical technique's lobes (final.frag, hbe.frag): deterministic renders,
-// so the ratio is float rounding alone (1e-3).
+// The maps' and the hierarchical technique's lobes (final.frag, hierarchical.frag): deterministic
+// renders, so the ratio is float rounding alone (1e-3).
 TEST_F(FurCoatGlTest, MapsAndHierarchicalSpecularLobesAreLitThroughTheCoat) {
   LUCENT_SKIP_WITHOUT_GL();
   expect_specular_through_the_coat(
@@ -220,13 +220,14 @@ TEST_F(FurCoatGlTest, MapsAndHierarchicalSpecularLobesAreLitThroughTheCoat) {
       },
       "maps", 1e-3);
   expect_specular_through_the_coat(
-      [](const Scene& s) { return render_hierarchical(s, hbe::Options{}); }, "hierarchical", 1e-3);
+      [](const Scene& s) { return render_hierarchical(s, hierarchical::Options{}); },
+      "hierarchical", 1e-3);
 }
 
 // The hierarchical technique's subsurface term under the coat (its leaves' irradiance times
-// T(mu), hbe_solver.cpp). It shades per vertex, so the slab's 12 triangles (vertices only at the
-// corners, where the lit side meets the top) say nothing; an open 40 mm plane of 2 mm quads lit
-// at mu has every leaf lit at mu, so the coated centre over the bare one is exp(-tau / mu)
+// T(mu), hierarchical_solver.cpp). It shades per vertex, so the slab's 12 triangles (vertices only
+// at the corners, where the lit side meets the top) say nothing; an open 40 mm plane of 2 mm quads
+// lit at mu has every leaf lit at mu, so the coated centre over the bare one is exp(-tau / mu)
 // whatever the hierarchy's own error. Deterministic: bound 1e-3 (float rounding).
 TEST_F(FurCoatGlTest, HierarchicalSubsurfaceIsLitThroughTheCoat) {
   LUCENT_SKIP_WITHOUT_GL();
@@ -253,8 +254,8 @@ TEST_F(FurCoatGlTest, HierarchicalSubsurfaceIsLitThroughTheCoat) {
     }
     Scene bare = slab.scene;
     bare.fur_coat.reset();
-    const ImageRgb coated = render_hierarchical(slab.scene, hbe::Options{});
-    const ImageRgb plain = render_hierarchical(bare, hbe::Options{});
+    const ImageRgb coated = render_hierarchical(slab.scene, hierarchical::Options{});
+    const ImageRgb plain = render_hierarchical(bare, hierarchical::Options{});
     for (int ch = 0; ch < 3; ++ch) {
       const double lit = testing_slab::centre_mean(plain, ch);
       ASSERT_GT(lit, 0) << "mu " << mu << " channel " << ch;

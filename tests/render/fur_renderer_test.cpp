@@ -8,9 +8,9 @@
 #include <cstdlib>
 #include <string>
 
+#include "area_light.h"
 #include "lucent/core/error.h"
 #include "lucent/materials/material.h"
-#include "lucent/render/area_light.h"
 #include "lucent/render/gl_context.h"
 
 namespace lucent::render {
@@ -38,8 +38,9 @@ TEST(FurLightSh, VertexFrameEqualsRotatingTheWorldFrameCoefficients) {
                                      rect_light({-30, 60, 20}, {10, 0, 0}, {0, 3, -8}, {2, 2, 2})};
   const Vec3f centre(5, 20, -3);
   const auto world = fur_light_sh(lights, centre, Eigen::Matrix3d::Identity());
-  for (const Vec3f n : {Vec3f(0, 1, 0), Vec3f(0.6f, 0.0f, 0.8f), Vec3f(-0.2f, -0.9f, 0.3883f).normalized(),
-                        Vec3f(0, 0.99999f, 0.0045f).normalized()}) {
+  for (const Vec3f& n :
+       {Vec3f(0, 1, 0), Vec3f(0.6f, 0.0f, 0.8f), Vec3f(-0.2f, -0.9f, 0.3883f).normalized(),
+        Vec3f(0, 0.99999f, 0.0045f).normalized()}) {
     const Eigen::Matrix3d M = fur_vertex_frame(n);
     EXPECT_NEAR((M * M.transpose() - Eigen::Matrix3d::Identity()).norm(), 0, 1e-12);
     EXPECT_NEAR(M.determinant(), 1, 1e-12);  // a rotation, not a reflection

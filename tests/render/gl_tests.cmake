@@ -30,7 +30,8 @@ lucent_add_test(area_light_test
   LIBS lucent::render lucent::materials OpenGL::OpenGL)
 # White-box: both include private headers of render/ (gl_program.h, gl_bssrdf.h,
 # radiance_maps_sampling.h).
-foreach(t glsl_twin_test radiance_maps_test sh_renderer_test area_light_test fur_glsl_twin_test)
+foreach(t glsl_twin_test radiance_maps_test sh_renderer_test area_light_test fur_glsl_twin_test
+          fur_renderer_test)
   target_include_directories(${t} PRIVATE ${LUCENT_RENDER_PRIVATE_DIRS})
 endforeach()
 lucent_add_test(hierarchical_renderer_test

@@ -1,8 +1,8 @@
 // The hierarchical boundary-element technique on the GPU
 // (render/techniques/hierarchical/hierarchical_renderer.cpp,
-// render/techniques/hierarchical/shaders/hbe.*): against the CPU reference with the same R_d (the
-// standard dipole of the chord distance), finiteness and determinism, and a deforming mesh and a
-// material change reaching the image. Skipped without headless OpenGL 4.5.
+// render/techniques/hierarchical/shaders/hierarchical.*): against the CPU reference with the same
+// R_d (the standard dipole of the chord distance), finiteness and determinism, and a deforming mesh
+// and a material change reaching the image. Skipped without headless OpenGL 4.5.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -48,7 +48,7 @@ TEST_F(HierarchicalRendererTest, LitSphereMatchesTheReference) {
   for (const char* material : {"potato", "marble"}) {
     const Scene scene = lit_sphere(material, 48);
     RenderStats stats;
-    const ImageRgb image = render_hierarchical(scene, hbe::Options{}, &stats);
+    const ImageRgb image = render_hierarchical(scene, hierarchical::Options{}, &stats);
     ReferenceOptions ro;
     ro.pixel_samples = 1024;
     ro.threads = 2;

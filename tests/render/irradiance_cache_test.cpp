@@ -9,9 +9,9 @@
 #include <random>
 #include <vector>
 
+#include "area_light.h"
 #include "irradiance_cache.h"
 #include "lucent/materials/material.h"
-#include "lucent/render/area_light.h"
 #include "lucent/render/image_compare.h"
 #include "lucent/render/reference_renderer.h"
 #include "lucent/render/scene.h"

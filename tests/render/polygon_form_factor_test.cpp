@@ -1,7 +1,8 @@
-// render/include/lucent/render/polygon_form_factor.h and area_light.h: the point-to-polygon form
+// render/core/polygon_form_factor.h and area_light.h: the point-to-polygon form
 // factor against closed forms from the radiation-heat-transfer catalogues (differential element to
-// a parallel and to a perpendicular rectangle, coaxial disc), its symmetries, the point-light limit,
-// the tangent-plane clip against brute-force quadrature, and the rect light's parsing and sampling.
+// a parallel and to a perpendicular rectangle, coaxial disc), its symmetries, the point-light
+// limit, the tangent-plane clip against brute-force quadrature, and the rect light's parsing and
+// sampling.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -10,10 +11,10 @@
 #include <random>
 #include <vector>
 
+#include "area_light.h"
 #include "lucent/core/error.h"
-#include "lucent/render/area_light.h"
-#include "lucent/render/polygon_form_factor.h"
 #include "lucent/render/scene.h"
+#include "polygon_form_factor.h"
 
 namespace lucent::render {
 namespace {

@@ -91,6 +91,47 @@ TEST(RadianceMapSampling, DiscWeightsIntegrateTheDiscArea) {
   }
 }
 
+// More lights than disc samples (N = 1 or 2 under 3 to 16 lights): every light still gathers
+// a whole disc, and the frame still holds N samples (the GPU buffer holds N: before, each light
+// past the N-th appended its own copy and `--maps-samples 1` under the default rig of three
+// lights wrote past the buffer and crashed).
+TEST(RadianceMapSampling, MoreLightsThanSamplesShareTheFramesSamples) {
+  for (auto [M, N, lights] : {std::tuple{1, 1, 3}, std::tuple{2, 2, 16}, std::tuple{64, 2, 5}}) {
+    for (const auto selection : {DiscSelection::kStrata, DiscSelection::kNearest}) {
+      for (int frame : {1, 2, 7}) {
+        const detail::DiscSamples disc = detail::exponential_disc_samples(
+            M, N, 0.2, 20.0, lights, Eigen::Vector3d::Zero(), selection, frame);
+        ASSERT_EQ(int(disc.samples.size()), N) << M << " " << N << " " << lights;
+        ASSERT_EQ(int(disc.light_count.size()), lights);
+        for (int l = 0; l < lights; ++l) {
+          EXPECT_GE(disc.light_count[l], 1);
+          EXPECT_GE(disc.light_offset[l], 0);
+          EXPECT_LE(disc.light_offset[l] + disc.light_count[l], N) << "light " << l;
+          if (l >= N) {
+            // It gathers what light l mod N gathers: the same range of the frame's samples.
+            EXPECT_EQ(disc.light_offset[l], disc.light_offset[l % N]);
+            EXPECT_EQ(disc.light_count[l], disc.light_count[l % N]);
+          }
+          if (selection == DiscSelection::kNearest) {
+            // Its weights integrate the sampling density over the used disc (as in
+            // DiscWeightsIntegrateTheDiscArea).
+            const double sigma = 0.2, rho = disc.used_radius_mm;
+            const double Z = 2 * std::numbers::pi / (sigma * sigma) *
+                             (1 - std::exp(-sigma * rho) * (1 + sigma * rho));
+            double density = 0;
+            for (int i = disc.light_offset[l]; i < disc.light_offset[l] + disc.light_count[l];
+                 ++i) {
+              const detail::DiscSample& d = disc.samples[std::size_t(i)];
+              density += d.weight_mm2 * std::exp(-sigma * std::hypot(d.x_mm, d.y_mm));
+            }
+            EXPECT_NEAR(density, Z, 1e-5 * Z) << "light " << l;
+          }
+        }
+      }
+    }
+  }
+}
+
 TEST(RadianceMapSampling, NearestNOfMShrinkTheDisc) {
   // Seed §6.2.2: for the same N, a larger M puts the samples closer to x_o.
   const auto small = detail::exponential_disc_samples(100, 16, 0.1, 100.0, 1);

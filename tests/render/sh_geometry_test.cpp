@@ -1,4 +1,4 @@
-// Tests of render/include/lucent/render/sh_translucency.h, second part: the attenuation in the
+// Tests of render/techniques/sh/sh_translucency.h, second part: the attenuation in the
 // thickness (eq. 12 with its guard, and its integral over the plane) and the look-up geometry
 // (refraction, the ray-box exit, the scaled box, the sphere's thickness). The basis, cube map,
 // projection and irradiance are in sh_translucency_test.cpp.
@@ -13,7 +13,7 @@
 #include <random>
 
 #include "lucent/materials/medium.h"
-#include "lucent/render/sh_translucency.h"
+#include "sh_translucency.h"
 
 namespace lucent::render::sh {
 namespace {

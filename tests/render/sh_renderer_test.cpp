@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "gl_api.h"
+#include "gl_fixture.h"
 #include "gl_program.h"
 #include "lucent/materials/material.h"
 #include "lucent/render/gl_context.h"
@@ -22,8 +23,7 @@
 #include "lucent/render/reference_renderer.h"
 #include "lucent/render/scene.h"
 #include "lucent/render/sh_renderer.h"
-#include "lucent/render/sh_translucency.h"
-#include "gl_fixture.h"
+#include "sh_translucency.h"
 
 namespace lucent::render {
 namespace {

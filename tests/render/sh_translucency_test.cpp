@@ -1,8 +1,8 @@
-// Tests of render/include/lucent/render/sh_translucency.h: the SH basis, cube-map texel weights and
+// Tests of render/techniques/sh/sh_translucency.h: the SH basis, cube-map texel weights and
 // directions, projection and the irradiance matrix of the
 // spherical-harmonics fast translucency technique (Banterle and Chalmers 2006, Banterle &
 // Chalmers); the attenuation and look-up geometry are in sh_geometry_test.cpp.
-#include "lucent/render/sh_translucency.h"
+#include "sh_translucency.h"
 
 #include <gtest/gtest.h>
 

@@ -120,7 +120,7 @@ TEST_F(TechniqueTest, TheSettersKeepTheirContract) {
     t->render_frame();
     EXPECT_EQ(t->read_image().data, before.data) << info.name;
     if (info.id == TechniqueId::kHierarchical) {
-      const hbe::Stats& s = static_cast<HierarchicalRenderer&>(*t).stats();
+      const hierarchical::Stats& s = static_cast<HierarchicalRenderer&>(*t).stats();
       EXPECT_EQ(s.links, links);
       EXPECT_EQ(s.form_factor_calls, 0) << "the same material re-linked";
     }

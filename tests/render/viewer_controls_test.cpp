@@ -3,7 +3,7 @@
 // file watcher.
 #include "lucent/render/viewer_controls.h"
 
-#include "lucent/render/area_light.h"
+#include "area_light.h"
 
 #include <gtest/gtest.h>
 

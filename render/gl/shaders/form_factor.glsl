@@ -1,4 +1,4 @@
-// lucent GLSL 1: twin of render/include/lucent/render/polygon_form_factor.h: the point-to-polygon
+// lucent GLSL 1: twin of render/core/polygon_form_factor.h: the point-to-polygon
 // form factor by the contour sum (Jacob 1993 eq. 19, the angle by atan2) after clipping the polygon to
 // the receiver's tangent half-space; F > 0 on the side of the winding normal. Held to the C++ by
 // tests/render/glsl_twin_test.cpp.

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <sstream>
 #include <string>
 #include <thread>
 
@@ -34,6 +35,24 @@ double gauss12(F&& f, double a, double b) {
 int wrap(int i, int n) { return ((i % n) + n) % n; }
 
 }  // namespace
+
+std::string FurOptions::to_string() const {
+  std::ostringstream s;
+  const auto coat = [&](const Coat& c) {
+    s << "{hairs=" << c.hairs << ", width=" << c.width_min << ".." << c.width_max
+      << ", length=" << c.length << "}";
+  };
+  s << "FurOptions{texels=" << texels << ", shells=" << shells
+    << ", shell_spacing=" << shell_spacing << ", overcoat=";
+  coat(overcoat);
+  s << ", undercoat=";
+  coat(undercoat);
+  s << ", curl_max=" << curl_max << ", optical_density=" << optical_density
+    << ", coverage=" << (coverage == CoverageRule::kSeed ? "seed" : "exact")
+    << ", quadrature_nodes=" << quadrature_nodes << ", seed=" << seed << ", tile_mm=" << tile_mm
+    << ", height_mm=" << height_mm << "}";
+  return s.str();
+}
 
 void FurOptions::validate() const {
   if (texels < 2 || texels > 4096) throw Error("--fur-texels: expected 2..4096");

@@ -28,6 +28,38 @@ gl::Buffer storage(const void* data, std::size_t bytes) {
   return b;
 }
 
+// Per vertex: the lights' SH in its frame at the coat's middle, 3 channels x 7 vec4
+// (coefficients 4k..4k+3).
+std::vector<float> vertex_light_sh(const Scene& scene, const fur::FurOptions& o) {
+  const Mesh& mesh = scene.mesh;
+  const std::size_t V = mesh.positions.size();
+  std::vector<float> light(V * 84, 0.0f);
+  const float lift = 0.5f * float(o.height_mm);  // the coat's middle
+  for (std::size_t v = 0; v < V; ++v) {
+    const Vec3f n = mesh.normals[v].normalized();
+    const auto c = fur_light_sh(scene.lights, mesh.positions[v] + lift * n, fur_vertex_frame(n));
+    for (int ch = 0; ch < 3; ++ch)
+      for (int i = 0; i < kShCoefficients; ++i)
+        light[v * 84 + std::size_t(ch) * 28 + std::size_t(i)] =
+            float(c[std::size_t(ch)][std::size_t(i)]);
+  }
+  return light;
+}
+
+// `image` as an RGBA32F texture, rows bottom-up as GL stores them (alpha 1).
+gl::Texture upload_image(const ImageRgb& image) {
+  const int W = image.width, H = image.height;
+  std::vector<float> rgba(std::size_t(W) * H * 4, 1.0f);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x)
+      for (int c = 0; c < 3; ++c)
+        rgba[(std::size_t(H - 1 - y) * W + x) * 4 + std::size_t(c)] = image.at(x, y, c);
+  gl::Texture texture = gl::create_texture(GL_TEXTURE_2D);
+  glTextureStorage2D(texture.id(), 1, GL_RGBA32F, W, H);
+  glTextureSubImage2D(texture.id(), 0, 0, 0, W, H, GL_RGBA, GL_FLOAT, rgba.data());
+  return texture;
+}
+
 }  // namespace
 
 ImageRgb render_fur_mesh(const Scene& scene, const fur::FurOptions& options,
@@ -52,17 +84,8 @@ ImageRgb render_fur_mesh(const Scene& scene, const fur::FurOptions& options,
 
   const auto context = GlContext::create_headless();
   const int W = scene.camera.width, H = scene.camera.height;
-  // Per vertex: the lights' SH in its frame, 3 channels x 7 vec4 (coefficients 4k..4k+3).
   const std::size_t V = mesh.positions.size();
-  std::vector<float> light(V * 84, 0.0f);
-  const float lift = 0.5f * float(o.height_mm);  // the coat's middle
-  for (std::size_t v = 0; v < V; ++v) {
-    const Vec3f n = mesh.normals[v].normalized();
-    const auto c = fur_light_sh(scene.lights, mesh.positions[v] + lift * n, fur_vertex_frame(n));
-    for (int ch = 0; ch < 3; ++ch)
-      for (int i = 0; i < kShCoefficients; ++i)
-        light[v * 84 + std::size_t(ch) * 28 + std::size_t(i)] = float(c[std::size_t(ch)][std::size_t(i)]);
-  }
+  const std::vector<float> light = vertex_light_sh(scene, o);
   std::vector<unsigned> indices;
   indices.reserve(mesh.triangles.size() * 3);
   for (const auto& t : mesh.triangles) indices.insert(indices.end(), t.begin(), t.end());
@@ -74,15 +97,7 @@ ImageRgb render_fur_mesh(const Scene& scene, const fur::FurOptions& options,
 
   const gl::Texture transfer = detail::upload_fur_transfer(tile);
   const gl::Sampler sampler = detail::fur_sampler();
-  // The skin, rows bottom-up as GL stores them.
-  std::vector<float> rgba(std::size_t(W) * H * 4, 1.0f);
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x)
-      for (int c = 0; c < 3; ++c)
-        rgba[(std::size_t(H - 1 - y) * W + x) * 4 + std::size_t(c)] = skin.at(x, y, c);
-  const gl::Texture skin_texture = gl::create_texture(GL_TEXTURE_2D);
-  glTextureStorage2D(skin_texture.id(), 1, GL_RGBA32F, W, H);
-  glTextureSubImage2D(skin_texture.id(), 0, 0, 0, W, H, GL_RGBA, GL_FLOAT, rgba.data());
+  const gl::Texture skin_texture = upload_image(skin);
 
   const gl::Program program({{GL_VERTEX_SHADER, "fur_mesh.vert"}, {GL_FRAGMENT_SHADER, "fur_mesh.frag"}});
   const gl::Program blit({{GL_VERTEX_SHADER, "background.vert"}, {GL_FRAGMENT_SHADER, "image_blit.frag"}});

@@ -4,12 +4,12 @@
 #include <chrono>
 #include <cmath>
 
+#include "area_light.h"
 #include "fur_gl.h"
 #include "gl_api.h"
 #include "gl_frame.h"
 #include "gl_program.h"
 #include "lucent/core/error.h"
-#include "lucent/render/area_light.h"
 #include "lucent/render/gl_context.h"
 #include "lucent/render/technique.h"
 #include "radiance_maps_sampling.h"

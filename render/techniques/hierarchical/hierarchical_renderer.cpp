@@ -29,7 +29,7 @@ double now_ms() {
 
 struct HierarchicalRenderer::Impl {
   Scene scene;
-  std::unique_ptr<hbe::Solver> solver;
+  std::unique_ptr<hierarchical::Solver> solver;
   gl::MeshBuffers mesh;
   gl::Buffer B;
   gl::Program program;
@@ -76,7 +76,7 @@ struct HierarchicalRenderer::Impl {
 HierarchicalRenderer::HierarchicalRenderer() = default;
 HierarchicalRenderer::~HierarchicalRenderer() = default;
 
-void HierarchicalRenderer::setup(const Scene& scene, const hbe::Options& options) {
+void HierarchicalRenderer::setup(const Scene& scene, const hierarchical::Options& options) {
   impl_ = std::make_unique<Impl>();
   Impl& m = *impl_;
   m.scene = scene;
@@ -90,7 +90,7 @@ void HierarchicalRenderer::setup(const Scene& scene, const hbe::Options& options
   m.width = scene.camera.width;
   m.height = scene.camera.height;
   if (m.width < 1 || m.height < 1) throw Error("--size: the image has no pixels");
-  m.solver = std::make_unique<hbe::Solver>(scene, options);
+  m.solver = std::make_unique<hierarchical::Solver>(scene, options);
   m.mesh = gl::upload_mesh(mesh);
   m.B = gl::create_buffer();
   glNamedBufferStorage(m.B.id(), GLsizeiptr(mesh.positions.size() * 3 * sizeof(float)), nullptr,
@@ -100,12 +100,13 @@ void HierarchicalRenderer::setup(const Scene& scene, const hbe::Options& options
   glEnableVertexArrayAttrib(vao, 2);
   glVertexArrayAttribFormat(vao, 2, 3, GL_FLOAT, GL_FALSE, 0);
   glVertexArrayAttribBinding(vao, 2, 2);
-  // Area lights' branches always compiled here: hbe.frag is one cheap pass.
+  // Area lights' branches always compiled here: hierarchical.frag is one cheap pass.
   std::vector<std::string> defines = {"LUCENT_MAX_LIGHTS " + std::to_string(kMaxLights),
                                       "LUCENT_AREA_LIGHTS"};
   defines.push_back("LUCENT_MAX_AREA_LIGHTS " + std::to_string(gl::kMaxAreaLights));
-  m.program =
-      gl::Program({{GL_VERTEX_SHADER, "hbe.vert"}, {GL_FRAGMENT_SHADER, "hbe.frag"}}, defines);
+  m.program = gl::Program(
+      {{GL_VERTEX_SHADER, "hierarchical.vert"}, {GL_FRAGMENT_SHADER, "hierarchical.frag"}},
+      defines);
   glProgramUniform1i(m.program.id(), m.program.location("u_environment"), GLint(kUnitEnvironment));
   m.final.build(scene, m.width, m.height, kUnitEnvironment);
   m.fit_bounds();
@@ -152,7 +153,7 @@ void HierarchicalRenderer::set_geometry(const std::vector<Vec3f>& positions,
 }
 
 void HierarchicalRenderer::setup(const Scene& scene, const TechniqueOptions& options) {
-  setup(scene, options.hbe);
+  setup(scene, options.hierarchical);
 }
 
 bool HierarchicalRenderer::converged() const {
@@ -161,7 +162,7 @@ bool HierarchicalRenderer::converged() const {
 
 FrameStats HierarchicalRenderer::frame_stats() const {
   const Impl& m = *impl_;
-  const hbe::Stats& s = m.solver->stats();
+  const hierarchical::Stats& s = m.solver->stats();
   FrameStats f;
   f.frames = m.frames;
   f.pass_ms = {{"link", s.link_ms},
@@ -217,12 +218,17 @@ void HierarchicalRenderer::present(float exposure, int width, int height) const 
   impl_->final.present(exposure, width, height);
 }
 
-const hbe::Stats& HierarchicalRenderer::stats() const { return impl_->solver->stats(); }
+const hierarchical::Stats& HierarchicalRenderer::stats() const {
+  return impl_->solver->stats();
+}
 double HierarchicalRenderer::upload_ms() const { return impl_->upload_ms; }
 double HierarchicalRenderer::draw_ms() const { return impl_->draw_ms; }
-const hbe::Solver& HierarchicalRenderer::solver() const { return *impl_->solver; }
+const hierarchical::Solver& HierarchicalRenderer::solver() const {
+  return *impl_->solver;
+}
 
-ImageRgb render_hierarchical(const Scene& scene, const hbe::Options& options, RenderStats* stats) {
+ImageRgb render_hierarchical(const Scene& scene, const hierarchical::Options& options,
+                             RenderStats* stats) {
   const double t0 = now_ms();
   const auto context = GlContext::create_headless();
   HierarchicalRenderer renderer;
@@ -230,7 +236,7 @@ ImageRgb render_hierarchical(const Scene& scene, const hbe::Options& options, Re
   renderer.render_frame();
   ImageRgb image = renderer.read_image();
   if (stats != nullptr) {
-    const hbe::Stats& s = renderer.stats();
+    const hierarchical::Stats& s = renderer.stats();
     stats->technique = "hierarchical";
     stats->width = scene.camera.width;
     stats->height = scene.camera.height;

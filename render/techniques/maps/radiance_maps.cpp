@@ -4,6 +4,22 @@
 
 namespace lucent::render {
 
+void RadianceMapOptions::validate() const {
+  if (max_blur_level < -1 || max_blur_level > 8) {
+    throw Error("--maps-max-blur: expected -1 (automatic) to 8 levels, got " +
+                std::to_string(max_blur_level));
+  }
+  if (!(shadow_bias_texels >= 0 && shadow_bias_texels <= 64) ||
+      !(shrink_texels >= 0 && shrink_texels <= 64)) {
+    throw Error("radiance maps: the shadow bias and shrink must be 0..64 texels");
+  }
+  if (!(convergence_tolerance > 0 && convergence_tolerance < 1)) {
+    throw Error("radiance maps: the convergence tolerance must be in (0, 1)");
+  }
+  for (int t : snapshot_frames)
+    if (t < 1) throw Error("--snapshots: frames must be at least 1, got " + std::to_string(t));
+}
+
 std::string RadianceMapOptions::to_string() const {
   std::ostringstream s;
   s << "RadianceMapOptions{max_blur_level=" << max_blur_level
@@ -82,7 +98,7 @@ void RadianceMapRenderer::Impl::build(const Scene& s, const RenderSettings& rs,
     throw Error("--light: the radiance maps take at most " + std::to_string(kMaxLights) +
                 " lights, got " + std::to_string(scene.lights.size()));
   }
-  if (options.max_blur_level < -1) throw Error("--max-blur: must be >= 0 (or -1: automatic)");
+  options.validate();
   if (options.max_blur_level < 0) {
     options.max_blur_level = settings.disc_distribution == DiscDistribution::kProfile ? 0 : 2;
   }
@@ -91,11 +107,11 @@ void RadianceMapRenderer::Impl::build(const Scene& s, const RenderSettings& rs,
   GLint max_block = 0;
   glGetIntegerv(GL_MAX_UNIFORM_BLOCK_SIZE, &max_block);
   if (K * 80 > max_block) {
-    throw Error("--directions: this OpenGL allows at most " + std::to_string(max_block / 80) +
+    throw Error("--maps-directions: this OpenGL allows at most " + std::to_string(max_block / 80) +
                 " radiance-map directions, got " + std::to_string(K));
   }
   if (settings.samples * 16 > max_block) {
-    throw Error("--samples: this OpenGL allows at most " + std::to_string(max_block / 16) +
+    throw Error("--maps-samples: this OpenGL allows at most " + std::to_string(max_block / 16) +
                 " disc samples, got " + std::to_string(settings.samples));
   }
   centre = scene.mesh.centre();

@@ -9,13 +9,13 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "area_light.h"
 #include "gl_api.h"
 #include "gl_area_lights.h"
 #include "gl_bssrdf.h"
 #include "gl_frame.h"
 #include "gl_program.h"
 #include "lucent/core/error.h"
-#include "lucent/render/area_light.h"
 #include "lucent/render/environment.h"
 #include "lucent/render/gl_context.h"
 #include "lucent/render/radiance_maps.h"

@@ -84,7 +84,7 @@ long stratum_step(long size) {
 
 DiscPoints exponential_disc_points(int M, double sigma_star_per_mm, double disc_radius_mm,
                                   const Eigen::Vector3d& shift) {
-  if (M < 1) throw Error("--disc-points: need M >= 1, got " + std::to_string(M));
+  if (M < 1) throw Error("--maps-disc-points: need M >= 1, got " + std::to_string(M));
   DiscPoints out;
   out.distribution = DiscDistribution::kExponential;
   out.sigma_star_per_mm = sigma_star_per_mm;
@@ -116,7 +116,7 @@ DiscPoints exponential_disc_points(int M, double sigma_star_per_mm, double disc_
 DiscPoints profile_disc_points(int M, const materials::Material& material,
                                materials::DiffusionModel model, double disc_radius_mm,
                                const Eigen::Vector3d& shift) {
-  if (M < 1) throw Error("--disc-points: need M >= 1, got " + std::to_string(M));
+  if (M < 1) throw Error("--maps-disc-points: need M >= 1, got " + std::to_string(M));
   const RadialProfileDensity density(material, model, disc_radius_mm);
   if (!density.valid()) {
     // Nothing scatters: no subsurface light; a uniform disc keeps the sums well defined (zero).
@@ -141,7 +141,7 @@ DiscSamples select_disc_samples(const DiscPoints& disc, int N, int lights, DiscS
                                 int frame) {
   const int M = int(disc.points.size());
   if (M < 1 || N < 1 || N > M) {
-    throw Error("--samples/--disc-points: need 1 <= N <= M, got N=" + std::to_string(N) +
+    throw Error("--maps-samples/--maps-disc-points: need 1 <= N <= M, got N=" + std::to_string(N) +
                 ", M=" + std::to_string(M));
   }
   if (lights < 1) throw Error("radiance maps: the scene has no lights");
@@ -186,6 +186,13 @@ DiscSamples select_disc_samples(const DiscPoints& disc, int N, int lights, DiscS
   // N / n_l of the frame's N.
   const int rotation = strata ? t % L : 0;
   for (int l = 0; l < lights; ++l) {
+    if (l >= L) {
+      // More lights than samples: light l gathers exactly what light l mod L gathers (the same
+      // points and weights), so it shares that range: the frame's samples stay N.
+      out.light_offset.push_back(out.light_offset[std::size_t(l % L)]);
+      out.light_count.push_back(out.light_count[std::size_t(l % L)]);
+      continue;
+    }
     out.light_offset.push_back(int(out.samples.size()));
     const int first = ((l % L) - rotation + L) % L;
     int count = 0;

@@ -8,11 +8,11 @@
 #include <cmath>
 #include <sstream>
 
+#include "area_light.h"
 #include "lucent/core/error.h"
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/medium.h"
-#include "lucent/render/area_light.h"
-#include "lucent/render/sh_translucency.h"
+#include "sh_translucency.h"
 
 namespace lucent::render {
 namespace {
@@ -60,15 +60,15 @@ std::string to_string(ShAttenuation attenuation) {
 
 void ShOptions::validate() const {
   if (shadow_map_size < 16 || shadow_map_size > 8192) {
-    throw Error("--shadow-map: the shadow map must be 16..8192 texels, got " +
+    throw Error("--sh-shadow-map: the shadow map must be 16..8192 texels, got " +
                 std::to_string(shadow_map_size));
   }
   if (cube_map_size < 4 || cube_map_size > 2048) {
-    throw Error("--cube-map: the cube-map faces must be 4..2048 texels, got " +
+    throw Error("--sh-cube-map: the cube-map faces must be 4..2048 texels, got " +
                 std::to_string(cube_map_size));
   }
   if (!(depth_blur_sigma_texels >= 0 && depth_blur_sigma_texels <= 32)) {
-    throw Error("--depth-blur: sigma must be 0..32 shadow-map texels");
+    throw Error("--sh-depth-blur: sigma must be 0..32 shadow-map texels");
   }
   if (!(shadow_bias_texels >= 0 && shadow_bias_texels <= 64)) {
     throw Error("sh: the shadow bias must be 0..64 texels");

@@ -64,6 +64,7 @@ struct FurOptions {
   double tile_mm = 8.0, height_mm = 1.5;
 
   void validate() const;  ///< throws lucent::Error naming the option
+  std::string to_string() const;
 };
 
 struct Hair {

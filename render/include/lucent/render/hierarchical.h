@@ -1,12 +1,14 @@
 // The hierarchical boundary-element technique (`--technique hierarchical`, Mertens et al.: Mertens,
 // Kautz, Bekaert, Seidel, Van Reeth 2003). B(x_o) = integral of E(x_i) R_d(x_i, x_o) dx_i is
-// solved on a face-cluster hierarchy (hbe_hierarchy.h) in the manner of hierarchical radiosity:
+// solved on a face-cluster hierarchy (hierarchical_clusters.h) in the manner of hierarchical
+// radiosity:
 //   links: from the root to itself, refined by a solid-angle oracle (below);
 //   per frame: irradiance E at the leaves (the triangles' midpoints, shadow rays as the
 //   reference's), pulled up as area-weighted averages; B gathered over the links
-//   (B_R += F(E, R) E_E, F the form factor of hbe_form_factor.h or a single midpoint sample);
-//   pushed down (each child adds its parent's B); per-vertex B (area-weighted over the faces around
-//   a welded vertex) to the GPU, where the fragment shader takes (1 / pi) F_t(eta, n . w_o) B.
+//   (B_R += F(E, R) E_E, F the form factor of hierarchical_form_factor.h or a single midpoint
+//   sample); pushed down (each child adds its parent's B); per-vertex B (area-weighted over the
+//   faces around a welded vertex) to the GPU, where the fragment shader takes (1 / pi) F_t(eta, n .
+//   w_o) B.
 //
 // The oracle (the seed gives the rule, not the thresholds; lucent's "deviation" and defaults):
 //   omega(x, E) = 2 pi (1 - d / sqrt(d^2 + A_E / pi)), the solid angle of a disc of E's area at
@@ -25,11 +27,11 @@
 #include <string>
 #include <vector>
 
-#include "lucent/render/hbe_form_factor.h"
-#include "lucent/render/hbe_hierarchy.h"
+#include "lucent/render/hierarchical_clusters.h"
+#include "lucent/render/hierarchical_form_factor.h"
 #include "lucent/render/scene.h"
 
-namespace lucent::render::hbe {
+namespace lucent::render::hierarchical {
 
 enum class Mode {
   kRender,       ///< links kept; a frame updates irradiance and gathers (lights move)
@@ -115,4 +117,4 @@ std::vector<std::array<double, 3>> all_pairs_B(const Mesh& mesh, const materials
                                                const std::vector<std::array<double, 3>>& face_E,
                                                const FormFactorOptions& options);
 
-}  // namespace lucent::render::hbe
+}  // namespace lucent::render::hierarchical

@@ -1,7 +1,7 @@
 // `--technique hierarchical` on OpenGL 4.5: the CPU solve of hierarchical.h each frame (links as
 // its mode keeps them), the per-vertex B uploaded as a vertex attribute, and the fragment shader's
 // (1 / pi) F_t(eta, n . w_o) B plus the lights' specular lobes
-// (render/techniques/hierarchical/shaders/hbe.frag).
+// (render/techniques/hierarchical/shaders/hierarchical.frag).
 #pragma once
 
 #include <cstdint>
@@ -25,8 +25,8 @@ class HierarchicalRenderer final : public Technique {
 
   /// Builds the hierarchy, uploads the mesh, compiles the programs. Throws lucent::Error on bad
   /// options, an empty mesh, no light or more than 16 lights.
-  void setup(const Scene& scene, const hbe::Options& options = {});
-  /// The same with options.hbe.
+  void setup(const Scene& scene, const hierarchical::Options& options = {});
+  /// The same with options.hierarchical.
   void setup(const Scene& scene, const TechniqueOptions& options) override;
   TechniqueId id() const override { return TechniqueId::kHierarchical; }
   void set_camera(const Camera& camera) override;  ///< same size as at setup
@@ -37,17 +37,17 @@ class HierarchicalRenderer final : public Technique {
   void set_geometry(const std::vector<Vec3f>& positions,
                     const std::vector<Vec3f>& normals) override;
 
-  /// One frame: the solve (hbe::Solver::solve), the upload, the draw.
+  /// One frame: the solve (hierarchical::Solver::solve), the upload, the draw.
   bool render_frame() override;  ///< always true
 
   ImageRgb read_image() const override;                  ///< linear RGB, row 0 at the top
   std::vector<std::uint8_t> read_mask() const override;  ///< 1 where a pixel sees the object
   void present(float exposure, int width, int height) const override;
 
-  const hbe::Stats& stats() const;  ///< the solve's, last frame
+  const hierarchical::Stats& stats() const;  ///< the solve's, last frame
   double upload_ms() const;         ///< last frame's B upload
   double draw_ms() const;           ///< last frame's draw (glFinish + wall clock)
-  const hbe::Solver& solver() const;
+  const hierarchical::Solver& solver() const;
 
   /// The last frame's passes (the solve's stages, the upload, the draw) and its links.
   FrameStats frame_stats() const override;
@@ -61,7 +61,7 @@ class HierarchicalRenderer final : public Technique {
 
 /// One frame in a headless context of its own (fills `stats` when given: technique
 /// "hierarchical", the phases' times, links and form-factor counts).
-ImageRgb render_hierarchical(const Scene& scene, const hbe::Options& options,
+ImageRgb render_hierarchical(const Scene& scene, const hierarchical::Options& options,
                              RenderStats* stats = nullptr);
 
 }  // namespace lucent::render

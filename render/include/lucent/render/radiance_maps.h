@@ -60,6 +60,7 @@ struct RadianceMapOptions {
   std::function<void(int frame, const ImageRgb& image)> on_snapshot;
   std::vector<int> snapshot_frames;
 
+  void validate() const;  ///< throws lucent::Error naming the option
   std::string to_string() const;
 };
 

@@ -78,6 +78,9 @@ struct ReferenceOptions {
   bool environment_reflection = false;
   /// Called now and then with the fraction done (0..1), from one thread at a time.
   std::function<void(double)> progress;
+
+  void validate() const;  ///< throws lucent::Error naming the option
+  std::string to_string() const;
 };
 
 struct ReferenceImage {

@@ -7,7 +7,7 @@
 //   3. its projection onto 9 SH coefficients per channel by a two-stage reduction in a compute
 //      shader (the coefficients stay on the GPU);
 //   4. the final pass: B = q^T M q at the exit of the refracted view ray from the box, times the
-//      attenuation of eq. 12 in the thickness (render/include/lucent/render/sh_translucency.h has
+//      attenuation of eq. 12 in the thickness (render/techniques/sh/sh_translucency.h has
 //      the math, its corrections of the seed and its guard; the shaders say the rest).
 // Lights: every light adds to the cube map's irradiance; the thickness, the cube map's shadows
 // and the primary light's specular shadow come from one light, the primary: the one bringing the

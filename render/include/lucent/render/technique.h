@@ -67,7 +67,7 @@ struct TechniqueOptions {
   RenderSettings settings;
   RadianceMapOptions maps;
   ShOptions sh;
-  hbe::Options hbe;
+  hierarchical::Options hierarchical;
   fur::FurOptions fur;
   ReferenceOptions reference;
 };
@@ -77,8 +77,7 @@ struct TechniqueOptions {
 ImageRgb render_still(TechniqueId id, const Scene& scene, const TechniqueOptions& options,
                       RenderStats* stats);
 
-/// The options technique `id` was run with, as text (the render statistics' "settings"); empty
-/// where the technique reports none.
+/// The options technique `id` was run with, as text (the render statistics' "settings").
 std::string settings_text(TechniqueId id, const TechniqueOptions& options);
 
 }  // namespace lucent::render

@@ -34,15 +34,18 @@ struct ViewerOptions {
   OrbitView view;                  ///< --view
   double object_size_mm = 100;     ///< the mesh's bounding-box diagonal as loaded
   TechniqueId technique = TechniqueId::kMaps;
-  hbe::Options hbe;                ///< --technique hierarchical: oracle, form factor, mode
+  hierarchical::Options hierarchical;  ///< --technique hierarchical: oracle, form factor, mode
   ShOptions sh;                    ///< --technique sh: shadow map, cube map, depth blur, Fresnel
   fur::FurOptions fur;             ///< --technique fur: the tile (--mesh tile)
   float deform_amplitude = 0;      ///< sine deformer: fraction of the diagonal; 0 = off
   /// Actions, one per frame, separated by ';' (tests and demos drive the window with them):
   ///   orbit DX DY | light DX DY   mouse drags in pixels (left button / right button)
   ///   zoom STEPS                  scroll-wheel steps (up = closer)
-  ///   set NAME VALUE              N, M, q, K, Ws, Wl, T, exposure, size, deform, disc,
-  ///                               technique, model
+  ///   set NAME VALUE              the CLI's flag without dashes: maps-samples, maps-disc-points,
+  ///                               maps-q, maps-directions, maps-radiance-map, maps-light-map,
+  ///                               maps-frames, maps-disc-selection, technique, model, exposure,
+  ///                               object-size-mm, deform; and light_scale (the panel's N, M, q,
+  ///                               K, Ws, Wl, T, disc, size still work)
   ///   key LETTER                 a key press (S, R, H, D)
   ///   panel on|off | difference on|off   the panel; the difference view against the reference
   ///   screenshot-panel FILE.png   a screenshot with the panel (`screenshot` leaves it out)

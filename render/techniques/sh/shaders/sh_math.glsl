@@ -1,4 +1,4 @@
-// lucent GLSL 1: twin of render/include/lucent/render/sh_translucency.h (Banterle & Chalmers, the SH fast
+// lucent GLSL 1: twin of render/techniques/sh/sh_translucency.h (Banterle & Chalmers, the SH fast
 // translucency technique): the Ramamoorthi-Hanrahan real basis of bands 0-2 (no Condon-Shortley
 // phase), the cube-map texel geometry and differential solid angle, the symmetric 4x4 irradiance
 // matrix (row 4 as R&H, not the seed's misprint), eq. 12's attenuation with the d_eff = sqrt(d^2 +

@@ -4,7 +4,7 @@
 // and curvature change at run time). Finer clusters are embedded in coarser ones: each cluster is
 // a contiguous range of `faces()` and its boundary is the oriented edge list of its faces with the
 // shared (internal) edges cancelled, so that a planar cluster's form factor is its boundary's
-// contour sum (hbe_form_factor.h).
+// contour sum (hierarchical_form_factor.h).
 #pragma once
 
 #include <array>
@@ -15,7 +15,7 @@
 
 #include "lucent/render/scene.h"
 
-namespace lucent::render::hbe {
+namespace lucent::render::hierarchical {
 
 struct Cluster {
   int first_face = 0, face_count = 0;  ///< range in Hierarchy::faces()
@@ -58,6 +58,13 @@ class Hierarchy {
   int depth() const { return max_depth_; }
 
  private:
+  // The stages of build(): vertices welded by position, the levels of pairwise merges (from the
+  // faces' adjacency across shared edges), the depth-first order, the clusters' boundaries.
+  void weld_vertices(const Mesh& mesh);
+  void merge_levels(std::vector<std::vector<int>> adjacency);
+  void order_depth_first();
+  void build_boundaries();
+
   std::vector<Cluster> clusters_;
   std::vector<int> faces_, weld_, leaf_of_face_;
   std::vector<std::array<int, 3>> welded_triangles_;
@@ -67,4 +74,4 @@ class Hierarchy {
   int root_ = -1, max_depth_ = 0;
 };
 
-}  // namespace lucent::render::hbe
+}  // namespace lucent::render::hierarchical

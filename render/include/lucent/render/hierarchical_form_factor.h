@@ -38,7 +38,7 @@
 
 #include "lucent/materials/medium.h"
 
-namespace lucent::render::hbe {
+namespace lucent::render::hierarchical {
 
 using Vec2d = Eigen::Vector2d;
 using Vec3d = Eigen::Vector3d;
@@ -110,4 +110,4 @@ double point_form_factor(const materials::DiffusionCoefficients<double>& c, cons
                          const Vec3d& n_o, const Vec3d& midpoint, double area,
                          DipolePlacement placement = DipolePlacement::kChord);
 
-}  // namespace lucent::render::hbe
+}  // namespace lucent::render::hierarchical

@@ -7,8 +7,8 @@
 #include <array>
 #include <vector>
 
-#include "lucent/render/polygon_form_factor.h"
 #include "lucent/render/scene.h"
+#include "polygon_form_factor.h"
 
 namespace lucent::render {
 

@@ -3,7 +3,7 @@
 // Gauss-Legendre to 1e-13 (what the issue asks for; only the exact r-integration is shared), and
 // (2) a plain 2D cubature of R_d over the triangle (conical Gauss product rules on 4^5
 // sub-triangles), which shares nothing but the dipole formula.
-#include "lucent/render/hbe_form_factor.h"
+#include "lucent/render/hierarchical_form_factor.h"
 
 #include <gtest/gtest.h>
 
@@ -17,7 +17,7 @@
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/material.h"
 
-namespace lucent::render::hbe {
+namespace lucent::render::hierarchical {
 namespace {
 
 using Coefficients = materials::DiffusionCoefficients<double>;
@@ -128,7 +128,7 @@ double relative(double a, double b) { return std::abs(a - b) / std::abs(b); }
 
 // The seed's Figure 3: a triangle with base 1 cm and height 0.5 cm, its tip at (x, 0) and its base
 // beyond, x_o at the origin in the same plane; skim milk, every channel, a sweep of the tip distance.
-TEST(HbeFormFactor, SeedFigure3SweepAgainstPolarQuadrature) {
+TEST(HierarchicalFormFactor, SeedFigure3SweepAgainstPolarQuadrature) {
   const Vec3d x_o(0, 0, 0), n(0, 0, 1);
   const std::vector<double> tips = {0.05, 0.1, 0.2, 0.5, 1, 2, 5, 10, 20};
   FormFactorOptions seed;
@@ -182,7 +182,7 @@ TEST(HbeFormFactor, SeedFigure3SweepAgainstPolarQuadrature) {
 }
 
 // The polar quadrature itself against the brute-force cubature (they share only R_d).
-TEST(HbeFormFactor, PolarQuadratureAgreesWithPlainCubature) {
+TEST(HierarchicalFormFactor, PolarQuadratureAgreesWithPlainCubature) {
   const Coefficients c = coefficients("marble", 1);
   const Vec3d n(0, 0, 1);
   const std::array<Vec3d, 3> tri = {Vec3d(0.3, -0.2, 0), Vec3d(2.5, -1.0, 0), Vec3d(1.0, 2.0, 0)};
@@ -194,7 +194,7 @@ TEST(HbeFormFactor, PolarQuadratureAgreesWithPlainCubature) {
 }
 
 // Tilted triangles (H != z), both placements, each against both quadratures.
-TEST(HbeFormFactor, TiltedTrianglesBothPlacements) {
+TEST(HierarchicalFormFactor, TiltedTrianglesBothPlacements) {
   const FormFactorOptions ours;
   for (const char* name : {"marble", "potato", "ketchup"}) {
     for (int ch = 0; ch < 3; ++ch) {
@@ -219,7 +219,7 @@ TEST(HbeFormFactor, TiltedTrianglesBothPlacements) {
 }
 
 // The receiver's foot on an edge's line (R = 0), inside and outside the edge, and at a vertex.
-TEST(HbeFormFactor, PoleOnAnEdgeLineAndAtAVertex) {
+TEST(HierarchicalFormFactor, PoleOnAnEdgeLineAndAtAVertex) {
   const Coefficients c = coefficients("potato", 0);
   const Vec3d n(0, 0, 1);
   const std::array<Vec3d, 3> tri = {Vec3d(0, 0, 0), Vec3d(3, 0, 0), Vec3d(1, 2, 0)};
@@ -240,7 +240,7 @@ TEST(HbeFormFactor, PoleOnAnEdgeLineAndAtAVertex) {
 }
 
 // Shared edges cancel: two triangles of a planar quad sum to the quad's four-edge form factor.
-TEST(HbeFormFactor, AdditiveAcrossASharedEdge) {
+TEST(HierarchicalFormFactor, AdditiveAcrossASharedEdge) {
   const Coefficients c = coefficients("marble", 2);
   const FormFactorOptions o;
   const Vec3d a(0, 0, 0), b(4, -1, 0), d(5, 3, 0), e(-0.5, 2.5, 0), n(0, 0, 1);
@@ -256,7 +256,7 @@ TEST(HbeFormFactor, AdditiveAcrossASharedEdge) {
 }
 
 // A large flat tessellated plane gives B / E = R_tot, the dipole's total diffuse reflectance.
-TEST(HbeFormFactor, LargeTessellatedPlaneGivesTheTotalDiffuseReflectance) {
+TEST(HierarchicalFormFactor, LargeTessellatedPlaneGivesTheTotalDiffuseReflectance) {
   const FormFactorOptions o;
   for (const char* name : {"marble", "potato", "skin1"}) {
     for (int ch = 0; ch < 3; ++ch) {
@@ -280,7 +280,7 @@ TEST(HbeFormFactor, LargeTessellatedPlaneGivesTheTotalDiffuseReflectance) {
   }
 }
 
-TEST(HbeFormFactor, FiniteAndZeroWhereItMustBe) {
+TEST(HierarchicalFormFactor, FiniteAndZeroWhereItMustBe) {
   const Coefficients c = coefficients("ketchup", 2);
   const FormFactorOptions o;
   const Vec3d n(0, 0, 1), a(0, 0, 0), b(1, 0, 0), d(0, 1, 0);
@@ -295,4 +295,4 @@ TEST(HbeFormFactor, FiniteAndZeroWhereItMustBe) {
 }
 
 }  // namespace
-}  // namespace lucent::render::hbe
+}  // namespace lucent::render::hierarchical

@@ -17,13 +17,14 @@
 #include "lucent/materials/material.h"
 #include "reference_common.h"
 
-namespace lucent::render::hbe {
+namespace lucent::render::hierarchical {
 
 Mode parse_mode(const std::string& text) {
   if (text == "render") return Mode::kRender;
   if (text == "incremental") return Mode::kIncremental;
   if (text == "on-the-fly") return Mode::kOnTheFly;
-  throw Error("--hbe-mode: expected render, incremental or on-the-fly, got '" + text + "'");
+  throw Error("--hierarchical-mode: expected render, incremental or on-the-fly, got '" + text +
+              "'");
 }
 
 std::string to_string(Mode mode) {
@@ -37,25 +38,27 @@ void Options::validate() const {
                   std::to_string(v));
     }
   };
-  positive(epsilon_1, "--hbe-epsilon1");
-  positive(epsilon_2, "--hbe-epsilon2");
-  positive(near, "--hbe-near");
+  positive(epsilon_1, "--hierarchical-epsilon1");
+  positive(epsilon_2, "--hierarchical-epsilon2");
+  positive(near, "--hierarchical-near");
   if (!(min_planarity >= 0 && min_planarity <= 1)) {
-    throw Error("--hbe-planarity: expected A'/A in [0, 1], got " + std::to_string(min_planarity));
+    throw Error("--hierarchical-planarity: expected A'/A in [0, 1], got " +
+                std::to_string(min_planarity));
   }
   if (!(form_factor.edge_constant > 0 && form_factor.edge_constant <= 2)) {
-    throw Error("--hbe-edge-constant: expected a value in (0, 2] (the seed's 2/5), got " +
+    throw Error("--hierarchical-edge-constant: expected a value in (0, 2] (the seed's 2/5), got " +
                 std::to_string(form_factor.edge_constant));
   }
-  if (budget < 1) throw Error("--hbe-budget: expected at least 1 form factor per frame");
+  if (budget < 1) throw Error("--hierarchical-budget: expected at least 1 form factor per frame");
 }
 
 std::string Options::to_string() const {
   std::ostringstream s;
-  s << "mode " << hbe::to_string(mode) << ", epsilon_1 " << epsilon_1 << " sr, epsilon_2 "
+  s << "mode " << hierarchical::to_string(mode) << ", epsilon_1 " << epsilon_1 << " sr, epsilon_2 "
     << epsilon_2 << " sr, near " << near << " sr, planarity " << min_planarity << ", edge c "
-    << form_factor.edge_constant << " (" << hbe::to_string(form_factor.rule) << ", dipole "
-    << hbe::to_string(form_factor.placement) << ")";
+    << form_factor.edge_constant << " (" << hierarchical::to_string(form_factor.rule) << ", dipole "
+    << hierarchical::to_string(form_factor.placement) << "), budget " << budget
+    << ", irradiance cache " << (irradiance_cache ? "on" : "off");
   return s.str();
 }
 
@@ -79,7 +82,8 @@ using Rgb = std::array<double, 3>;
 using Clock = std::chrono::steady_clock;
 // Shadow rays per face (or per cache grid vertex) for an area light (area_light_irradiance.h):
 // with the control variate only faces whose horizon cuts the light are noisy; on a 100 mm sphere
-// under a 50 mm rect the cache and per-leaf rays agree to 0.5% in E, 0.3% in B (hbe_solver_test).
+// under a 50 mm rect the cache and per-leaf rays agree to 0.5% in E, 0.3% in B
+// (hierarchical_solver_test).
 constexpr int kAreaLightSamples = 16;
 
 double ms_since(Clock::time_point t) {
@@ -515,4 +519,4 @@ std::vector<std::array<double, 3>> all_pairs_B(const Mesh& mesh, const materials
   return B;
 }
 
-}  // namespace lucent::render::hbe
+}  // namespace lucent::render::hierarchical

@@ -1,6 +1,6 @@
-// The semi-analytic subsurface form factor (hbe_form_factor.h has the derivation and its
+// The semi-analytic subsurface form factor (hierarchical_form_factor.h has the derivation and its
 // corrections of the seed).
-#include "lucent/render/hbe_form_factor.h"
+#include "lucent/render/hierarchical_form_factor.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,19 +8,21 @@
 
 #include "lucent/core/error.h"
 
-namespace lucent::render::hbe {
+namespace lucent::render::hierarchical {
 
 SegmentRule parse_segment_rule(const std::string& text) {
   if (text == "midpoint") return SegmentRule::kSeedMidpoint;
   if (text == "gauss2") return SegmentRule::kGauss2;
-  throw Error("--hbe-rule: expected midpoint (the seed's eq. 17) or gauss2, got '" + text + "'");
+  throw Error("--hierarchical-rule: expected midpoint (the seed's eq. 17) or gauss2, got '" + text +
+              "'");
 }
 
 DipolePlacement parse_dipole_placement(const std::string& text) {
   if (text == "chord") return DipolePlacement::kChord;
   if (text == "seed") return DipolePlacement::kSeed3d;
-  throw Error("--hbe-dipole: expected chord (lucent's R_d) or seed (sources at x -/+ z N), got '" +
-              text + "'");
+  throw Error(
+      "--hierarchical-dipole: expected chord (lucent's R_d) or seed (sources at x -/+ z N), got '" +
+      text + "'");
 }
 
 std::string to_string(SegmentRule rule) {
@@ -165,4 +167,4 @@ double point_form_factor(const materials::DiffusionCoefficients<double>& c, cons
   return area * c.alpha_prime / (4 * std::numbers::pi) * (term(c.z_r, sr) + term(c.z_v, sv));
 }
 
-}  // namespace lucent::render::hbe
+}  // namespace lucent::render::hierarchical

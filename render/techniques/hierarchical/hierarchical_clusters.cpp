@@ -1,8 +1,8 @@
-// Bottom-up face clustering (hbe_hierarchy.h): level by level, each cluster (smallest first) is
-// merged with the unmatched neighbour that keeps the pair most compact, radius^2 / area of the
-// union; a level that finds no neighbour to merge joins the nearest clusters instead (parts of
-// the mesh that share no edge).
-#include "lucent/render/hbe_hierarchy.h"
+// Bottom-up face clustering (hierarchical_clusters.h): level by level, each cluster (smallest
+// first) is merged with the unmatched neighbour that keeps the pair most compact, radius^2 / area
+// of the union; a level that finds no neighbour to merge joins the nearest clusters instead (parts
+// of the mesh that share no edge).
+#include "lucent/render/hierarchical_clusters.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -14,7 +14,7 @@
 
 #include "lucent/core/error.h"
 
-namespace lucent::render::hbe {
+namespace lucent::render::hierarchical {
 namespace {
 
 using Vec3d = Eigen::Vector3d;
@@ -50,41 +50,15 @@ double merge_cost(const Cluster& a, const Cluster& b) {
   return r * r / std::max(area, 1e-300);
 }
 
-}  // namespace
-
-Hierarchy Hierarchy::build(const Mesh& mesh) {
-  if (mesh.triangles.empty()) throw Error("hierarchical: the mesh has no triangles");
-  Hierarchy h;
-  // Weld vertices by position: neighbours are found across split normals and UV seams.
-  std::unordered_map<std::array<float, 3>, int, PositionHash> ids;
-  h.weld_.resize(mesh.positions.size());
-  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
-    const std::array<float, 3> p = {mesh.positions[v].x(), mesh.positions[v].y(),
-                                    mesh.positions[v].z()};
-    auto [it, inserted] = ids.emplace(p, int(h.welded_.size()));
-    if (inserted) h.welded_.push_back(mesh.positions[v].cast<double>());
-    h.weld_[v] = it->second;
-  }
-  const int T = int(mesh.triangles.size());
-  h.welded_triangles_.resize(std::size_t(T));
-  for (int t = 0; t < T; ++t) {
-    for (int k = 0; k < 3; ++k) {
-      h.welded_triangles_[std::size_t(t)][std::size_t(k)] =
-          h.weld_[mesh.triangles[std::size_t(t)][std::size_t(k)]];
-    }
-  }
-  // Leaves: cluster t is triangle t.
-  h.clusters_.resize(std::size_t(T));
-  h.leaf_of_face_.resize(std::size_t(T));
-  std::iota(h.leaf_of_face_.begin(), h.leaf_of_face_.end(), 0);
-  h.update_geometry(mesh.positions);  // leaves only so far (no parents yet)
-
-  // Neighbours across shared edges.
+// Each face's neighbours across its edges (welded vertex indices).
+std::vector<std::vector<int>> face_adjacency(const std::vector<std::array<int, 3>>& triangles) {
+  const int T = int(triangles.size());
   std::unordered_map<std::uint64_t, std::vector<int>> edge_faces;
   edge_faces.reserve(std::size_t(3 * T));
   for (int t = 0; t < T; ++t) {
-    const auto& w = h.welded_triangles_[std::size_t(t)];
-    for (int k = 0; k < 3; ++k) edge_faces[edge_key(w[std::size_t(k)], w[std::size_t((k + 1) % 3)])].push_back(t);
+    const auto& w = triangles[std::size_t(t)];
+    for (int k = 0; k < 3; ++k)
+      edge_faces[edge_key(w[std::size_t(k)], w[std::size_t((k + 1) % 3)])].push_back(t);
   }
   std::vector<std::vector<int>> adjacency(static_cast<std::size_t>(T));
   for (const auto& [key, faces] : edge_faces) {
@@ -92,24 +66,68 @@ Hierarchy Hierarchy::build(const Mesh& mesh) {
       for (int b : faces)
         if (a != b) adjacency[std::size_t(a)].push_back(b);
   }
+  return adjacency;
+}
 
+}  // namespace
+
+Hierarchy Hierarchy::build(const Mesh& mesh) {
+  if (mesh.triangles.empty()) throw Error("hierarchical: the mesh has no triangles");
+  Hierarchy h;
+  h.weld_vertices(mesh);
+  const int T = int(mesh.triangles.size());
+  // Leaves: cluster t is triangle t.
+  h.clusters_.resize(std::size_t(T));
+  h.leaf_of_face_.resize(std::size_t(T));
+  std::iota(h.leaf_of_face_.begin(), h.leaf_of_face_.end(), 0);
+  h.update_geometry(mesh.positions);  // leaves only so far (no parents yet)
+  h.merge_levels(face_adjacency(h.welded_triangles_));
+  h.order_depth_first();
+  h.build_boundaries();
+  h.update_geometry(mesh.positions);
+  return h;
+}
+
+void Hierarchy::weld_vertices(const Mesh& mesh) {
+  // Weld vertices by position: neighbours are found across split normals and UV seams.
+  std::unordered_map<std::array<float, 3>, int, PositionHash> ids;
+  weld_.resize(mesh.positions.size());
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+    const std::array<float, 3> p = {mesh.positions[v].x(), mesh.positions[v].y(),
+                                    mesh.positions[v].z()};
+    auto [it, inserted] = ids.emplace(p, int(welded_.size()));
+    if (inserted) welded_.push_back(mesh.positions[v].cast<double>());
+    weld_[v] = it->second;
+  }
+  const int T = int(mesh.triangles.size());
+  welded_triangles_.resize(std::size_t(T));
+  for (int t = 0; t < T; ++t) {
+    for (int k = 0; k < 3; ++k) {
+      welded_triangles_[std::size_t(t)][std::size_t(k)] =
+          weld_[mesh.triangles[std::size_t(t)][std::size_t(k)]];
+    }
+  }
+}
+
+void Hierarchy::merge_levels(std::vector<std::vector<int>> adjacency) {
+  const int T = int(welded_triangles_.size());
   std::vector<int> current(static_cast<std::size_t>(T));
   std::iota(current.begin(), current.end(), 0);
   auto make_parent = [&](int a, int b) {
     Cluster p;
     p.child = {a, b};
-    merged_sphere(h.clusters_[std::size_t(a)], h.clusters_[std::size_t(b)], p.midpoint, p.radius,
+    merged_sphere(clusters_[std::size_t(a)], clusters_[std::size_t(b)], p.midpoint, p.radius,
                   p.area);
-    const int id = int(h.clusters_.size());
-    h.clusters_[std::size_t(a)].parent = id;
-    h.clusters_[std::size_t(b)].parent = id;
-    h.clusters_.push_back(p);
+    const int id = int(clusters_.size());
+    clusters_[std::size_t(a)].parent = id;
+    clusters_[std::size_t(b)].parent = id;
+    clusters_.push_back(p);
     adjacency.emplace_back();
     return id;
   };
   while (current.size() > 1) {
     std::sort(current.begin(), current.end(), [&](int a, int b) {
-      const double aa = h.clusters_[std::size_t(a)].area, ab = h.clusters_[std::size_t(b)].area;
+      const double aa = clusters_[std::size_t(a)].area, ab = clusters_[std::size_t(b)].area;
       return aa != ab ? aa < ab : a < b;
     });
     std::unordered_set<int> in_level(current.begin(), current.end()), matched;
@@ -121,7 +139,7 @@ Hierarchy Hierarchy::build(const Mesh& mesh) {
       double best_cost = std::numeric_limits<double>::infinity();
       for (int b : adjacency[std::size_t(a)]) {
         if (b == a || matched.count(b) || !in_level.count(b)) continue;
-        const double cost = merge_cost(h.clusters_[std::size_t(a)], h.clusters_[std::size_t(b)]);
+        const double cost = merge_cost(clusters_[std::size_t(a)], clusters_[std::size_t(b)]);
         if (cost < best_cost || (cost == best_cost && b < best)) {
           best_cost = cost;
           best = b;
@@ -146,8 +164,9 @@ Hierarchy Hierarchy::build(const Mesh& mesh) {
         double best_d = std::numeric_limits<double>::infinity();
         for (std::size_t j = 0; j < current.size(); ++j) {
           if (used[j]) continue;
-          const double d = (h.clusters_[std::size_t(current[i])].midpoint -
-                            h.clusters_[std::size_t(current[j])].midpoint).squaredNorm();
+          const double d = (clusters_[std::size_t(current[i])].midpoint -
+                            clusters_[std::size_t(current[j])].midpoint)
+                               .squaredNorm();
           if (d < best_d) {
             best_d = d;
             best = j;
@@ -163,11 +182,11 @@ Hierarchy Hierarchy::build(const Mesh& mesh) {
     }
     // The new level's adjacency: the children's neighbours, lifted to their clusters.
     auto top = [&](int c) {
-      while (h.clusters_[std::size_t(c)].parent >= 0) c = h.clusters_[std::size_t(c)].parent;
+      while (clusters_[std::size_t(c)].parent >= 0) c = clusters_[std::size_t(c)].parent;
       return c;
     };
     for (int p : next) {
-      const Cluster& cp = h.clusters_[std::size_t(p)];
+      const Cluster& cp = clusters_[std::size_t(p)];
       if (cp.leaf() || !adjacency[std::size_t(p)].empty()) continue;
       std::unordered_set<int> neighbours;
       for (int c : cp.child)
@@ -180,45 +199,50 @@ Hierarchy Hierarchy::build(const Mesh& mesh) {
     }
     current = std::move(next);
   }
-  h.root_ = current[0];
+  root_ = current[0];
+}
 
+void Hierarchy::order_depth_first() {
+  const int T = int(welded_triangles_.size());
   // Depth-first order: face ranges, depths, the post-order for bottom-up passes.
-  h.faces_.clear();
-  h.faces_.reserve(std::size_t(T));
-  std::vector<std::pair<int, bool>> stack = {{h.root_, false}};
+  faces_.clear();
+  faces_.reserve(std::size_t(T));
+  std::vector<std::pair<int, bool>> stack = {{root_, false}};
   while (!stack.empty()) {
     auto [id, expanded] = stack.back();
     stack.pop_back();
-    Cluster& c = h.clusters_[std::size_t(id)];
+    Cluster& c = clusters_[std::size_t(id)];
     if (expanded) {
-      const Cluster& a = h.clusters_[std::size_t(c.child[0])];
-      const Cluster& b = h.clusters_[std::size_t(c.child[1])];
+      const Cluster& a = clusters_[std::size_t(c.child[0])];
+      const Cluster& b = clusters_[std::size_t(c.child[1])];
       c.first_face = a.first_face;
       c.face_count = a.face_count + b.face_count;
-      h.post_order_.push_back(id);
+      post_order_.push_back(id);
       continue;
     }
-    c.depth = c.parent >= 0 ? h.clusters_[std::size_t(c.parent)].depth + 1 : 0;
-    h.max_depth_ = std::max(h.max_depth_, c.depth);
+    c.depth = c.parent >= 0 ? clusters_[std::size_t(c.parent)].depth + 1 : 0;
+    max_depth_ = std::max(max_depth_, c.depth);
     if (c.leaf()) {
-      c.first_face = int(h.faces_.size());
+      c.first_face = int(faces_.size());
       c.face_count = 1;
-      h.faces_.push_back(id);  // leaf id == its triangle
-      h.post_order_.push_back(id);
+      faces_.push_back(id);  // leaf id == its triangle
+      post_order_.push_back(id);
       continue;
     }
     stack.push_back({id, true});
     stack.push_back({c.child[1], false});
     stack.push_back({c.child[0], false});
   }
+}
 
+void Hierarchy::build_boundaries() {
   // Boundaries, bottom-up: a parent's edges are its children's minus the pairs that cancel.
-  std::vector<std::vector<std::array<int, 2>>> edges(h.clusters_.size());
-  for (int id : h.post_order_) {
-    const Cluster& c = h.clusters_[std::size_t(id)];
+  std::vector<std::vector<std::array<int, 2>>> edges(clusters_.size());
+  for (int id : post_order_) {
+    const Cluster& c = clusters_[std::size_t(id)];
     auto& out = edges[std::size_t(id)];
     if (c.leaf()) {
-      const auto& w = h.welded_triangles_[std::size_t(id)];
+      const auto& w = welded_triangles_[std::size_t(id)];
       for (int k = 0; k < 3; ++k) out.push_back({w[std::size_t(k)], w[std::size_t((k + 1) % 3)]});
       continue;
     }
@@ -236,14 +260,12 @@ Hierarchy Hierarchy::build(const Mesh& mesh) {
       }
     // The children's lists are no longer needed once both parents' levels are built.
   }
-  for (std::size_t id = 0; id < h.clusters_.size(); ++id) {
-    Cluster& c = h.clusters_[id];
-    c.first_edge = int(h.boundary_.size());
+  for (std::size_t id = 0; id < clusters_.size(); ++id) {
+    Cluster& c = clusters_[id];
+    c.first_edge = int(boundary_.size());
     c.edge_count = int(edges[id].size());
-    h.boundary_.insert(h.boundary_.end(), edges[id].begin(), edges[id].end());
+    boundary_.insert(boundary_.end(), edges[id].begin(), edges[id].end());
   }
-  h.update_geometry(mesh.positions);
-  return h;
 }
 
 void Hierarchy::update_geometry(const std::vector<Vec3f>& positions) {
@@ -290,4 +312,4 @@ void Hierarchy::update_geometry(const std::vector<Vec3f>& positions) {
   }
 }
 
-}  // namespace lucent::render::hbe
+}  // namespace lucent::render::hierarchical

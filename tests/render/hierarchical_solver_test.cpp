@@ -9,12 +9,12 @@
 #include <numbers>
 #include <vector>
 
+#include "area_light.h"
 #include "lucent/core/error.h"
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/material.h"
-#include "lucent/render/area_light.h"
 
-namespace lucent::render::hbe {
+namespace lucent::render::hierarchical {
 namespace {
 
 Scene sphere_scene(int level, const std::string& material, double size_mm = 100) {
@@ -45,7 +45,7 @@ double relative_rms(const std::vector<std::array<double, 3>>& b,
   return std::sqrt(num / den);
 }
 
-TEST(HbeHierarchy, NestedRangesBoundariesAndGeometry) {
+TEST(HierarchicalClusters, NestedRangesBoundariesAndGeometry) {
   const Mesh mesh = load_mesh("sphere:3", 100);
   const Hierarchy h = Hierarchy::build(mesh);
   const int T = int(mesh.triangles.size());
@@ -84,7 +84,7 @@ TEST(HbeHierarchy, NestedRangesBoundariesAndGeometry) {
 
 // Per-face B against every triangle as an emitter through the exact form factor: the error falls
 // as the oracle's thresholds tighten.
-TEST(HbeSolver, ApproachesTheAllPairsSolutionAsEpsilonTightens) {
+TEST(HierarchicalSolver, ApproachesTheAllPairsSolutionAsEpsilonTightens) {
   Scene scene = sphere_scene(2, "potato", 40);  // 320 triangles, 40 mm
   Options loose;
   loose.epsilon_1 = 0.2;
@@ -115,7 +115,7 @@ TEST(HbeSolver, ApproachesTheAllPairsSolutionAsEpsilonTightens) {
   EXPECT_LE(link_counts[2], long(scene.mesh.triangles.size() * scene.mesh.triangles.size()));
 }
 
-TEST(HbeSolver, RenderModeEqualsOnTheFly) {
+TEST(HierarchicalSolver, RenderModeEqualsOnTheFly) {
   Scene scene = sphere_scene(3, "marble");
   Options render, fly;
   fly.mode = Mode::kOnTheFly;
@@ -137,7 +137,7 @@ TEST(HbeSolver, RenderModeEqualsOnTheFly) {
 
 // A deformation, then incremental frames (a small budget) until they agree with a from-scratch
 // solve of the deformed mesh; a material change likewise.
-TEST(HbeSolver, IncrementalConvergesToOnTheFly) {
+TEST(HierarchicalSolver, IncrementalConvergesToOnTheFly) {
   Scene scene = sphere_scene(3, "potato");
   Options inc;
   inc.mode = Mode::kIncremental;
@@ -174,7 +174,7 @@ TEST(HbeSolver, IncrementalConvergesToOnTheFly) {
 }
 
 // A large flat tessellated plane lit uniformly: B / E at the centre is the dipole's R_tot.
-TEST(HbeSolver, FlatPlaneGivesTheTotalDiffuseReflectance) {
+TEST(HierarchicalSolver, FlatPlaneGivesTheTotalDiffuseReflectance) {
   Scene scene;
   scene.material = materials::load_material("marble");
   const int n = 40;
@@ -211,7 +211,7 @@ TEST(HbeSolver, FlatPlaneGivesTheTotalDiffuseReflectance) {
 
 // Link counts against the seed's Table 3 (marble, 2.5 cm, T 2016 -> L 89K ... 131736 -> 6905K,
 // L ~ T^1.045): our oracle on icospheres of the same scale; the exponent is fitted and reported.
-TEST(HbeSolver, LinkCountGrowsNearLinearly) {
+TEST(HierarchicalSolver, LinkCountGrowsNearLinearly) {
   std::vector<double> logT, logL;
   for (int level = 2; level <= 4; ++level) {
     Scene scene = sphere_scene(level, "marble", 25);
@@ -229,7 +229,7 @@ TEST(HbeSolver, LinkCountGrowsNearLinearly) {
   EXPECT_LT(slope, 1.4);  // far from the all-pairs exponent 2
 }
 
-TEST(HbeSolver, BadOptionsAreRefused) {
+TEST(HierarchicalSolver, BadOptionsAreRefused) {
   Scene scene = sphere_scene(1, "marble");
   Options o;
   o.epsilon_1 = 0;
@@ -243,7 +243,7 @@ TEST(HbeSolver, BadOptionsAreRefused) {
 // Area lights: the leaves' irradiance from the projection-map cache against 16 shadow rays per
 // leaf (both with the analytic form factor as control variate): the cache changes B by well
 // under a percent.
-TEST(HbeSolver, AreaLightIrradianceCacheAgreesWithShadowRays) {
+TEST(HierarchicalSolver, AreaLightIrradianceCacheAgreesWithShadowRays) {
   Scene scene = sphere_scene(3, "marble", 100);
   const Vec3f c(50, 50, 40);
   const Vec3f n = -c.normalized();
@@ -258,8 +258,8 @@ TEST(HbeSolver, AreaLightIrradianceCacheAgreesWithShadowRays) {
   for (const auto& e : a.face_E()) lit += e[0] > 0 ? 1 : 0;
   EXPECT_GT(lit, 0.3 * double(a.face_E().size()));  // the lit side
   const double e = relative_rms(a.face_E(), b.face_E()), bb = relative_rms(a.face_B(), b.face_B());
-  std::printf("hbe area light: cache vs shadow rays: E %.3f%%, B %.3f%% relative RMS\n", 100 * e,
-              100 * bb);
+  std::printf("hierarchical area light: cache vs shadow rays: E %.3f%%, B %.3f%% relative RMS\n",
+              100 * e, 100 * bb);
   EXPECT_LT(e, 0.01);
   EXPECT_LT(bb, 0.005);
   // A second solve reuses the cache (nothing changed): the same irradiance.
@@ -268,4 +268,4 @@ TEST(HbeSolver, AreaLightIrradianceCacheAgreesWithShadowRays) {
 }
 
 }  // namespace
-}  // namespace lucent::render::hbe
+}  // namespace lucent::render::hierarchical
