@@ -16,6 +16,68 @@ constexpr double kMaxNeeOpticalDepth = 60;
 // ---------------------------------------------------------------------------------------------
 // The transport kernel.
 
+// The entry point within a Gaussian beam's footprint (Box-Muller), mm.
+inline void sample_beam_footprint(double sigma_mm, Xoshiro256StarStar& rng, double& x, double& y) {
+  const double radius = sigma_mm * std::sqrt(-2 * std::log(rng.uniform_open()));
+  const double angle = 2 * kPi * rng.uniform();
+  x = radius * std::cos(angle), y = radius * std::sin(angle);
+}
+
+// Next-event estimation toward the camera: the collision's light leaving the surface the camera
+// sees, along the refracted view direction (mirrored in z for the far side: the camera below
+// looks up), into the pixel it lands in.
+template <bool kIsotropic>
+inline void score_camera(const Transport& t, double x, double y, double z, double ux, double uy,
+                         double uz, double w, PhotonScratch& scratch) {
+  const double s_exit = (t.far ? z + t.thickness_mm : -z) * t.inv_cos_t;
+  const double fi = (x + s_exit * t.wt_x) * t.inv_pixel_mm + t.half_size;
+  const double fj = (y + s_exit * t.wt_y) * t.inv_pixel_mm + t.half_size;
+  const double tau = t.sigma_t * s_exit;
+  if (!(fi >= 0 && fi < t.size_d && fj >= 0 && fj < t.size_d && tau < kMaxNeeOpticalDepth)) return;
+  double phase;
+  if constexpr (kIsotropic) {
+    phase = 1.0 / (4 * kPi);
+  } else {
+    phase = t.hg.pdf(ux * t.wt_x + uy * t.wt_y + (t.far ? -uz : uz) * t.wt_z);
+  }
+  const double v = w * t.nee_factor * phase * std::exp(-tau);
+  if (v > 0) {
+    const auto p = static_cast<std::size_t>(static_cast<int>(fj) * t.size + static_cast<int>(fi));
+    if (scratch.image[p] == 0) scratch.image_touched.push_back(static_cast<std::int32_t>(p));
+    scratch.image[p] += v;
+  }
+}
+
+// One photon's totals into the tally; its scratch bins and pixels back to zero.
+template <bool kImage>
+inline void add_photon_totals(const Transport& t, double reflected, double transmitted,
+                              double absorbed, std::uint64_t interactions, PhotonScratch& scratch,
+                              Tally& tally) {
+  tally.diffuse.add(reflected);
+  tally.transmitted.add(transmitted);
+  tally.absorbed.add(absorbed);
+  tally.interactions += interactions;
+  for (const int b : scratch.bins_touched) {
+    tally.bins[static_cast<std::size_t>(b)].add(scratch.bins[static_cast<std::size_t>(b)]);
+    scratch.bins[static_cast<std::size_t>(b)] = 0;
+  }
+  scratch.bins_touched.clear();
+  if constexpr (kImage) {
+    double integral = 0;
+    for (const std::int32_t p : scratch.image_touched) {
+      const auto i = static_cast<std::size_t>(p);
+      const double v = scratch.image[i];
+      Moments& m = tally.image[i];
+      if (m.sum == 0) tally.image_touched.push_back(p);
+      m.add(v);
+      integral += v;
+      scratch.image[i] = 0;
+    }
+    scratch.image_touched.clear();
+    tally.image_integral.add(integral * t.pixel_area_mm2);
+  }
+}
+
 template <bool kIsotropic, bool kImage, bool kFinite, bool kSplit>
 void trace_photons(const Transport& t, std::uint64_t photons, Xoshiro256StarStar& rng,
                    PhotonScratch& scratch, Tally& tally) {
@@ -24,11 +86,7 @@ void trace_photons(const Transport& t, std::uint64_t photons, Xoshiro256StarStar
 
   for (std::uint64_t n = 0; n < photons; ++n) {
     double x = 0, y = 0, z = 0;
-    if (t.beam_sigma_mm > 0) {  // the entry point within the beam's footprint (Box-Muller)
-      const double radius = t.beam_sigma_mm * std::sqrt(-2 * std::log(rng.uniform_open()));
-      const double angle = 2 * kPi * rng.uniform();
-      x = radius * std::cos(angle), y = radius * std::sin(angle);
-    }
+    if (t.beam_sigma_mm > 0) sample_beam_footprint(t.beam_sigma_mm, rng, x, y);
     double ux = t.ux0, uy = t.uy0, uz = t.uz0;
     double w = t.w0;
     double reflected = 0, transmitted = 0, absorbed = 0;
@@ -114,31 +172,7 @@ void trace_photons(const Transport& t, std::uint64_t photons, Xoshiro256StarStar
       ++interactions;
 
       if constexpr (kImage) {
-        if (t.nee) {
-          // To the surface the camera sees, along the refracted view direction (mirrored in z
-          // for the far side: the camera below looks up).
-          const double s_exit = (t.far ? z + t.thickness_mm : -z) * t.inv_cos_t;
-          const double fi = (x + s_exit * t.wt_x) * t.inv_pixel_mm + t.half_size;
-          const double fj = (y + s_exit * t.wt_y) * t.inv_pixel_mm + t.half_size;
-          const double tau = t.sigma_t * s_exit;
-          if (fi >= 0 && fi < t.size_d && fj >= 0 && fj < t.size_d && tau < kMaxNeeOpticalDepth) {
-            double phase;
-            if constexpr (kIsotropic) {
-              phase = 1.0 / (4 * kPi);
-            } else {
-              phase = t.hg.pdf(ux * t.wt_x + uy * t.wt_y + (t.far ? -uz : uz) * t.wt_z);
-            }
-            const double v = w * t.nee_factor * phase * std::exp(-tau);
-            if (v > 0) {
-              const auto p =
-                  static_cast<std::size_t>(static_cast<int>(fj) * t.size + static_cast<int>(fi));
-              if (scratch.image[p] == 0) {
-                scratch.image_touched.push_back(static_cast<std::int32_t>(p));
-              }
-              scratch.image[p] += v;
-            }
-          }
-        }
+        if (t.nee) score_camera<kIsotropic>(t, x, y, z, ux, uy, uz, w, scratch);
       }
 
       const double deposit = w * t.absorbed_fraction;
@@ -160,30 +194,7 @@ void trace_photons(const Transport& t, std::uint64_t photons, Xoshiro256StarStar
       }
     }
 
-    // The photon's totals.
-    tally.diffuse.add(reflected);
-    tally.transmitted.add(transmitted);
-    tally.absorbed.add(absorbed);
-    tally.interactions += interactions;
-    for (const int b : scratch.bins_touched) {
-      tally.bins[static_cast<std::size_t>(b)].add(scratch.bins[static_cast<std::size_t>(b)]);
-      scratch.bins[static_cast<std::size_t>(b)] = 0;
-    }
-    scratch.bins_touched.clear();
-    if constexpr (kImage) {
-      double integral = 0;
-      for (const std::int32_t p : scratch.image_touched) {
-        const auto i = static_cast<std::size_t>(p);
-        const double v = scratch.image[i];
-        Moments& m = tally.image[i];
-        if (m.sum == 0) tally.image_touched.push_back(p);
-        m.add(v);
-        integral += v;
-        scratch.image[i] = 0;
-      }
-      scratch.image_touched.clear();
-      tally.image_integral.add(integral * t.pixel_area_mm2);
-    }
+    add_photon_totals<kImage>(t, reflected, transmitted, absorbed, interactions, scratch, tally);
   }
   tally.photons += photons;
 }

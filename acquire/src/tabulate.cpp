@@ -219,6 +219,30 @@ double normal_exit(const SliceConstants& s, double sigma_t, double bottom, doubl
   return v;
 }
 
+// A group's sums as means per photon, per unit area of the real medium's annuli (or wedges of
+// them, both sides of y = 0: 1 / P of the annulus); pi L for the radiance.
+void normalise_group(const materials::TransportTableGrid& grid, std::size_t white_nodes,
+                     std::uint64_t white_photons, std::uint64_t photons,
+                     materials::TransportTableGroup& out) {
+  const int J = grid.rho_bins();
+  const int P = grid.phi_bins;
+  std::vector<double>& exitance = out.value[0];
+  std::vector<double>& radiance = out.value[1];
+  const auto traced = [&](std::size_t k) {
+    return double(k < white_nodes ? white_photons : photons);
+  };
+  for (std::size_t row = 0; row < grid.rows(); ++row) {
+    const double n = traced(row / std::size_t(P));
+    for (int j = 0; j < J; ++j) {
+      const double r0 = grid.rho_edge(j), r1 = grid.rho_edge(j + 1);
+      const double area = std::numbers::pi * (r1 * r1 - r0 * r0) / P;
+      exitance[row * std::size_t(J) + std::size_t(j)] /= n * area;
+      radiance[row * std::size_t(J) + std::size_t(j)] *= std::numbers::pi / (n * area);
+    }
+  }
+  for (std::size_t k = 0; k < out.total.size(); ++k) out.total[k] /= traced(k);
+}
+
 // One (slice, group) unit: the white run for the nodes of alpha' >= kDirectBelowAlbedo, a direct
 // (absorbing) run for each node below it.
 void trace_group(const SliceConstants& s, const std::vector<AlbedoNode>& nodes,
@@ -336,19 +360,7 @@ void trace_group(const SliceConstants& s, const std::vector<AlbedoNode>& nodes,
     }
   }
 
-  // Means per photon, per unit area of the real medium's annuli (or wedges of them, both sides
-  // of y = 0: 1 / P of the annulus); pi L for the radiance.
-  const auto traced = [&](std::size_t k) { return double(k < white_nodes ? white_photons : photons); };
-  for (std::size_t row = 0; row < grid.rows(); ++row) {
-    const double n = traced(row / std::size_t(P));
-    for (int j = 0; j < J; ++j) {
-      const double r0 = grid.rho_edge(j), r1 = grid.rho_edge(j + 1);
-      const double area = std::numbers::pi * (r1 * r1 - r0 * r0) / P;
-      exitance[row * std::size_t(J) + std::size_t(j)] /= n * area;
-      radiance[row * std::size_t(J) + std::size_t(j)] *= std::numbers::pi / (n * area);
-    }
-  }
-  for (std::size_t k = 0; k < K; ++k) out.total[k] /= traced(k);
+  normalise_group(grid, white_nodes, white_photons, photons, out);
 }
 
 }  // namespace

@@ -27,9 +27,13 @@ void ReferenceOptions::validate() const {
   require(cluster_ratio >= 0 && cluster_ratio < 1, "reference: cluster_ratio must be in [0, 1)");
 }
 
+std::string to_string(ReferenceSampling sampling) {
+  return sampling == ReferenceSampling::kProbes ? "probes" : "area";
+}
+
 std::string ReferenceOptions::to_string() const {
   std::ostringstream s;
-  s << "ReferenceOptions{sampling=" << (sampling == ReferenceSampling::kProbes ? "probes" : "area")
+  s << "ReferenceOptions{sampling=" << render::to_string(sampling)
     << ", pixel_samples=" << pixel_samples << ", surface_samples=" << surface_samples
     << ", passes=" << passes << ", threads=" << threads << ", seed=" << seed
     << ", shadows=" << shadows << ", area_light_samples=" << area_light_samples

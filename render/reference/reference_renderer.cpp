@@ -543,7 +543,7 @@ void ReferenceRun::fill_stats() {
                    {"gather", gather_ms}};
   stats.total_ms = ms_since(start);
   stats.details = {{"model", materials::to_string(model)},
-                   {"sampling", options.sampling == ReferenceSampling::kProbes ? "probes" : "area"},
+                   {"sampling", to_string(options.sampling)},
                    {"pixel_samples_per_pass", options.pixel_samples},
                    {"probe_hits", probe_hits},
                    {"surface_samples_per_pass", options.surface_samples},

@@ -36,6 +36,10 @@ int wrap(int i, int n) { return ((i % n) + n) % n; }
 
 }  // namespace
 
+std::string to_string(CoverageRule rule) {
+  return rule == CoverageRule::kSeed ? "seed" : "exact";
+}
+
 std::string FurOptions::to_string() const {
   std::ostringstream s;
   const auto coat = [&](const Coat& c) {
@@ -48,9 +52,8 @@ std::string FurOptions::to_string() const {
   s << ", undercoat=";
   coat(undercoat);
   s << ", curl_max=" << curl_max << ", optical_density=" << optical_density
-    << ", coverage=" << (coverage == CoverageRule::kSeed ? "seed" : "exact")
-    << ", quadrature_nodes=" << quadrature_nodes << ", seed=" << seed << ", tile_mm=" << tile_mm
-    << ", height_mm=" << height_mm << "}";
+    << ", coverage=" << fur::to_string(coverage) << ", quadrature_nodes=" << quadrature_nodes
+    << ", seed=" << seed << ", tile_mm=" << tile_mm << ", height_mm=" << height_mm << "}";
   return s.str();
 }
 

@@ -38,6 +38,7 @@
 namespace lucent::render::fur {
 
 enum class CoverageRule { kExact, kSeed };
+std::string to_string(CoverageRule rule);  ///< exact | seed
 
 struct Coat {
   int hairs = 0;

@@ -42,6 +42,7 @@ enum class ReferenceSampling {
   /// surface_samples uniform by area over the whole mesh, shared by every pixel, with clusters.
   kArea,
 };
+std::string to_string(ReferenceSampling sampling);  ///< probes | area
 
 struct ReferenceOptions {
   ReferenceSampling sampling = ReferenceSampling::kProbes;
