@@ -81,6 +81,7 @@ void run_render(RenderArguments& render_args) {
       progress_shown = true;
       print_progress(fraction);
     };
+    options.pathtrace.progress = options.reference.progress;
   }
   RenderStats stats;
   const ImageRgb image = render_still(args.technique_id, scene, options, &stats);

@@ -174,6 +174,8 @@ void check_options(SceneArguments& args, const render::TechniqueInfo& technique)
     throw Error("--object-size-mm: must be positive");
   }
   o.reference.validate();
+  o.pathtrace.seed = o.reference.seed;  // one --seed for both CPU renderers
+  o.pathtrace.validate();
   o.maps.validate();
   o.settings.validate();
   if (args.exposure == "auto") {
@@ -284,6 +286,7 @@ SceneSetup build_scene(SceneArguments& args) {
       throw Error("--env: " + env->path + " is black everywhere: no light");
     }
     scene.lights.insert(scene.lights.end(), env_lights.begin(), env_lights.end());
+    scene.environment_lights = int(env_lights.size());
     scene.environment = env->path;
   }
   scene.roughness = args.roughness;

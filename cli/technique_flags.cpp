@@ -91,6 +91,15 @@ CLI::Option* choice(CLI::App* cmd, CLI::App* g, const std::string& name, const s
   return choice_option(g, name, target, names, help);
 }
 
+// An enum's CLI names are the technique's own to_string (found by argument-dependent lookup), so
+// the flag, the Options' to_string and the viewer script spell a value alike.
+template <class Enum>
+std::vector<std::pair<std::string, Enum>> named(std::initializer_list<Enum> values) {
+  std::vector<std::pair<std::string, Enum>> names;
+  for (const Enum value : values) names.emplace_back(to_string(value), value);
+  return names;
+}
+
 const std::vector<std::pair<std::string, bool>> kOnOff = {{"on", true}, {"off", false}};
 
 // K, N and M, and the maps' sizes W_s and W_l, into group `g` (shared with `bench render`).
@@ -117,14 +126,14 @@ void add_maps_flags(CLI::App* cmd, render::RenderSettings& s, render::RadianceMa
   add_maps_sampling_flags(cmd, g, s);
   choice(
       cmd, g, "--maps-disc-distribution", "--disc-distribution", s.disc_distribution,
-      {{"profile", DiscDistribution::kProfile}, {"exponential", DiscDistribution::kExponential}},
+      named({DiscDistribution::kProfile, DiscDistribution::kExponential}),
       "profile (radii importance-sampled from the material's own profile, weights exact at "
       "any texel size) or exponential (Dal Corso 2014: e^(-sigma* r), sigma* = min sigma_tr / q)");
   flag(cmd, g, "--maps-q", "--q", s.q,
        "q, disc bias sigma* = min sigma_tr / q (q > 1 spreads the samples wider)",
        number_in(0, 1000, "", true));
   choice(cmd, g, "--maps-disc-selection", "--disc-selection", s.disc_selection,
-         {{"strata", DiscSelection::kStrata}, {"nearest", DiscSelection::kNearest}},
+         named({DiscSelection::kStrata, DiscSelection::kNearest}),
          "which N of the M points a frame gathers: strata (one of each of N radius strata, a new "
          "one every frame: converges to all M after M/N frames) or nearest (Dal Corso 2014: the "
          "N nearest, every frame; misses the far profile)");
@@ -145,9 +154,7 @@ void add_sh_flags(CLI::App* cmd, render::ShOptions& o) {
   choice(cmd, g, "--sh-fresnel", "", o.schlick, {{"exact", false}, {"schlick", true}},
          "F_t in the cube map: exact (unpolarised Fresnel) or schlick (the seed's)");
   choice(cmd, g, "--sh-attenuation", "", o.attenuation,
-         {{"seed", ShAttenuation::kSeed},
-          {"normalised", ShAttenuation::kNormalised},
-          {"slab", ShAttenuation::kSlab}},
+         named({ShAttenuation::kSeed, ShAttenuation::kNormalised, ShAttenuation::kSlab}),
          "the attenuation in the thickness: seed (eq. 12 as printed, guarded), normalised (eq. 12 "
          "scaled to R_tot at d = 0) or slab (eq. 12 integrated over the plane, scaled to R_tot at "
          "d = 0)");
@@ -164,9 +171,7 @@ void add_hierarchical_flags(CLI::App* cmd, render::hierarchical::Options& o) {
          "on: area lights' leaf irradiance from per-cluster projection maps (Jacob 1993) built "
          "once; off: 16 shadow rays per leaf every frame");
   choice(cmd, g, "--hierarchical-mode", "--hbe-mode", o.mode,
-         {{"render", Mode::kRender},
-          {"incremental", Mode::kIncremental},
-          {"on-the-fly", Mode::kOnTheFly}},
+         named({Mode::kRender, Mode::kIncremental, Mode::kOnTheFly}),
          "render (links kept), incremental (links repaired within --hierarchical-budget per "
          "frame) or on-the-fly (no stored links)");
   flag(cmd, g, "--hierarchical-epsilon1", "--hbe-epsilon1", o.epsilon_1,
@@ -182,10 +187,10 @@ void add_hierarchical_flags(CLI::App* cmd, render::hierarchical::Options& o) {
   flag(cmd, g, "--hierarchical-edge-constant", "--hbe-edge-constant", o.form_factor.edge_constant,
        "split edge segments until L/r0 < c and L sigma_tr < c (seed: 0.4)");
   choice(cmd, g, "--hierarchical-rule", "--hbe-rule", o.form_factor.rule,
-         {{"midpoint", SegmentRule::kSeedMidpoint}, {"gauss2", SegmentRule::kGauss2}},
+         named({SegmentRule::kSeedMidpoint, SegmentRule::kGauss2}),
          "per segment, midpoint (the seed's eq. 17) or gauss2 (two-point Gauss-Legendre)");
   choice(cmd, g, "--hierarchical-dipole", "--hbe-dipole", o.form_factor.placement,
-         {{"chord", DipolePlacement::kChord}, {"seed", DipolePlacement::kSeed3d}},
+         named({DipolePlacement::kChord, DipolePlacement::kSeed3d}),
          "chord (R_d of the chord distance, lucent's, as the reference) or seed (sources at x_o "
          "-/+ z n_o)");
   flag(cmd, g, "--hierarchical-budget", "--hbe-budget", o.budget,
@@ -201,7 +206,7 @@ void add_fur_flags(CLI::App* cmd, render::fur::FurOptions& o) {
   flag(cmd, g, "--fur-shells", "", o.shells, "shells (seed: 32)", whole_in(1, 1024, "fur shells"));
   flag(cmd, g, "--fur-seed", "", o.seed, "the hair generator's seed")->check(seed_value());
   choice(cmd, g, "--fur-coverage", "", o.coverage,
-         {{"exact", CoverageRule::kExact}, {"seed", CoverageRule::kSeed}},
+         named({CoverageRule::kExact, CoverageRule::kSeed}),
          "a hair's cross-section over the texels: exact (the disc's overlap with each texel) or "
          "seed (its chord and wedge approximations, eqs. 1-2: the wedge is 13-32% off once a "
          "disc leaves the texel corner)");
@@ -214,7 +219,7 @@ void add_reference_flags(CLI::App* cmd, render::ReferenceOptions& o) {
   using render::ReferenceSampling;
   CLI::App* g = cmd->add_option_group("reference", "--technique reference: the CPU reference");
   choice(cmd, g, "--reference-sampling", "", o.sampling,
-         {{"probes", ReferenceSampling::kProbes}, {"area", ReferenceSampling::kArea}},
+         named({ReferenceSampling::kProbes, ReferenceSampling::kArea}),
          "probes (points drawn from the profile around each pixel, found by probe rays; noise ~ "
          "1/sqrt(--reference-samples-pixel)) or area (--reference-samples uniform surface "
          "samples shared by all pixels)");
@@ -237,6 +242,21 @@ void add_reference_flags(CLI::App* cmd, render::ReferenceOptions& o) {
        thread_count());
 }
 
+void add_pathtrace_flags(CLI::App* cmd, render::PathTraceOptions& o) {
+  CLI::App* g = cmd->add_option_group(
+      "pathtrace", "--technique pathtrace: volumetric path tracing, the truth (CPU)");
+  flag(cmd, g, "--pathtrace-samples-pixel", "", o.pixel_samples,
+       "paths per pixel per pass and channel; noise ~ 1/sqrt(N) (the statistics give it)",
+       whole_in(1, 10000000, "paths per pixel"));
+  flag(cmd, g, "--pathtrace-passes", "", o.passes,
+       "progressive passes, each with new paths (image = their mean)",
+       whole_in(1, 1000000, "passes"));
+  choice(cmd, g, "--pathtrace-jitter", "", o.jitter, kOnOff,
+         "on: paths spread over each pixel (a box filter, edges anti-aliased); off: through its "
+         "centre (as the other techniques sample)");
+  flag(cmd, g, "--pathtrace-threads", "", o.threads, "worker threads (0 = all)", thread_count());
+}
+
 }  // namespace
 
 void add_maps_sampling_flags(CLI::App* cmd, render::RenderSettings& settings) {
@@ -251,6 +271,7 @@ void add_technique_flags(CLI::App* cmd, render::TechniqueOptions& options) {
   add_hierarchical_flags(cmd, options.hierarchical);
   add_fur_flags(cmd, options.fur);
   add_reference_flags(cmd, options.reference);
+  add_pathtrace_flags(cmd, options.pathtrace);
 }
 
 void warn_deprecated_flags(const CLI::App* cmd) {

@@ -132,32 +132,72 @@ Vec3f environment_lookup(const EnvironmentMap& map, const Vec3f& direction) {
   return out;
 }
 
-std::vector<Light> environment_lights(const EnvironmentMap& map, int count, std::uint64_t seed) {
-  if (count < 1) throw Error("--env: the number of lights must be at least 1");
+EnvironmentSampler::EnvironmentSampler(const EnvironmentMap& map) : map_(&map) {
   const auto& img = map.image;
   const int W = img.width, H = img.height;
   if (W < 1 || H < 1) throw Error(map.source.string() + ": empty environment map");
-
   // Weight of texel (i, j): luminance times its solid angle (2 pi / W)(cos theta_j - cos
   // theta_{j+1}), the exact form of the sin(theta) factor of Dal Corso 2014 §4.4 (equal to
-  // (2 pi^2 / (W H)) sin(theta) for small texels). Rows: marginal CDF; within a row: conditional
-  // CDF.
-  std::vector<double> band(H);
+  // (2 pi^2 / (W H)) sin(theta) for small texels).
+  band_.resize(H);
   for (int j = 0; j < H; ++j) {
-    band[j] = std::cos(kPi * j / H) - std::cos(kPi * (j + 1) / H);
+    band_[j] = std::cos(kPi * j / H) - std::cos(kPi * (j + 1) / H);
   }
-  std::vector<std::vector<double>> row_cdf(H, std::vector<double>(W + 1, 0.0));
-  std::vector<double> marginal(H + 1, 0.0);
+  row_cdf_.assign(H, std::vector<double>(W + 1, 0.0));
+  marginal_.assign(H + 1, 0.0);
   for (int j = 0; j < H; ++j) {
-    const double texel_sr = 2 * kPi / W * band[j];
+    const double texel_sr = 2 * kPi / W * band_[j];
     for (int i = 0; i < W; ++i) {
       const double f = luminance(img.at(i, j, 0), img.at(i, j, 1), img.at(i, j, 2)) * texel_sr;
-      row_cdf[j][i + 1] = row_cdf[j][i] + f;
+      row_cdf_[j][i + 1] = row_cdf_[j][i] + f;
     }
-    marginal[j + 1] = marginal[j] + row_cdf[j][W];
+    marginal_[j + 1] = marginal_[j] + row_cdf_[j][W];
   }
-  const double total = marginal[H];  // integral of luminance over the sphere
-  if (!(total > 0)) return {};
+  total_ = marginal_[H];
+}
+
+void EnvironmentSampler::pick(double xi_row, double xi_col, int& i, int& j, float& u,
+                              float& v) const {
+  const int W = map_->image.width, H = map_->image.height;
+  double t_row = 0, t_col = 0;
+  j = sample_cdf(marginal_, xi_row, t_row);
+  i = sample_cdf(row_cdf_[j], xi_col, t_col);
+  // Uniform in solid angle within the texel: cos(theta) uniform across the row's band.
+  const double cos_theta = std::cos(kPi * j / H) - t_row * band_[j];
+  const double theta = std::acos(std::clamp(cos_theta, -1.0, 1.0));
+  u = float((i + t_col) / W), v = float(theta / kPi);
+}
+
+Vec3f EnvironmentSampler::sample(double xi_row, double xi_col, double& pdf_sr) const {
+  pdf_sr = 0;
+  if (black()) return Vec3f(0, 1, 0);
+  int i = 0, j = 0;
+  float u = 0, v = 0;
+  pick(xi_row, xi_col, i, j, u, v);
+  const Vec3f direction = latlong_direction(u, v).normalized();
+  pdf_sr = pdf(direction);
+  return direction;
+}
+
+double EnvironmentSampler::pdf(const Vec3f& direction) const {
+  if (black()) return 0;
+  const auto& img = map_->image;
+  const Vec2f uv = latlong_coordinates(direction);
+  const int i = std::clamp(int(uv.x() * img.width), 0, img.width - 1);
+  // The row whose band holds cos(theta) (as pick draws it), not the rounded v.
+  const double cos_theta = std::cos(kPi * double(uv.y()));
+  int j = std::clamp(int(uv.y() * img.height), 0, img.height - 1);
+  while (j > 0 && cos_theta > std::cos(kPi * j / img.height)) --j;
+  while (j + 1 < img.height && cos_theta < std::cos(kPi * (j + 1) / img.height)) ++j;
+  return luminance(img.at(i, j, 0), img.at(i, j, 1), img.at(i, j, 2)) / total_;
+}
+
+std::vector<Light> environment_lights(const EnvironmentMap& map, int count, std::uint64_t seed) {
+  if (count < 1) throw Error("--env: the number of lights must be at least 1");
+  const EnvironmentSampler sampler(map);
+  const auto& img = map.image;
+  const double total = sampler.total();  // integral of luminance over the sphere
+  if (sampler.black()) return {};
 
   std::uint64_t state = seed;
   const double offset_u = double(splitmix64(state) >> 11) * 0x1.0p-53;
@@ -167,13 +207,9 @@ std::vector<Light> environment_lights(const EnvironmentMap& map, int count, std:
   for (int k = 0; k < count; ++k) {
     const double xi_row = std::fmod(radical_inverse(k + 1, 2) + offset_v, 1.0);
     const double xi_col = std::fmod(radical_inverse(k + 1, 3) + offset_u, 1.0);
-    double t_row = 0, t_col = 0;
-    const int j = sample_cdf(marginal, xi_row, t_row);
-    const int i = sample_cdf(row_cdf[j], xi_col, t_col);
-    // Uniform in solid angle within the texel: cos(theta) uniform across the row's band.
-    const double cos_theta = std::cos(kPi * j / H) - t_row * band[j];
-    const double theta = std::acos(std::clamp(cos_theta, -1.0, 1.0));
-    const float u = float((i + t_col) / W), v = float(theta / kPi);
+    int i = 0, j = 0;
+    float u = 0, v = 0;
+    sampler.pick(xi_row, xi_col, i, j, u, v);
 
     // pdf per sr = luminance / total, constant over the texel; with the texel's own radiance the
     // estimate L / (count pdf) is exact for a piecewise-constant map.

@@ -55,6 +55,10 @@ const std::vector<TechniqueInfo>& techniques() {
        true, all, "", true, true, false, &make<FurRenderer>},
       {TechniqueId::kReference, "reference", "CPU reference", "CPU reference",
        "reference (CPU, slow, exact up to sampling noise)", true, all, "", false, true, false},
+      {TechniqueId::kPathtrace, "pathtrace", "path-traced truth", "path tracer",
+       "pathtrace (CPU volumetric path tracing of the medium behind its smooth boundary: the "
+       "truth the others are held to; no diffusion model, --model is ignored)",
+       true, all, "traces the medium itself", false, false, false},
   };
   return table;
 }
@@ -102,6 +106,11 @@ ImageRgb render_still(TechniqueId id, const Scene& scene, const TechniqueOptions
       if (stats) *stats = std::move(result.stats);
       return std::move(result.image);
     }
+    case TechniqueId::kPathtrace: {
+      PathTraceImage result = render_pathtrace(scene, options.pathtrace);
+      if (stats) *stats = std::move(result.stats);
+      return std::move(result.image);
+    }
     case TechniqueId::kSh: return render_sh(scene, options.sh, stats);
     case TechniqueId::kHierarchical:
       return render_hierarchical(scene, options.hierarchical, stats);
@@ -134,6 +143,8 @@ std::string settings_text(TechniqueId id, const TechniqueOptions& options) {
       return options.fur.to_string();
     case TechniqueId::kReference:
       return options.reference.to_string();
+    case TechniqueId::kPathtrace:
+      return options.pathtrace.to_string();
   }
   return "";
 }

@@ -242,7 +242,7 @@ class Viewer {
   OrbitView view_;
   TechniqueId technique_ = TechniqueId::kMaps;
   // By TechniqueId; the reference's slot stays empty (it runs on reference_, a worker thread).
-  std::array<LiveTechnique, 5> live_;
+  std::array<LiveTechnique, 6> live_;
   SceneVersions versions_;
   bool fur_lobe_ = false;  // the seed's rotating lobe light instead of the scene's lights
   std::unique_ptr<ReferenceWorker> reference_;

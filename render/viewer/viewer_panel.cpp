@@ -59,6 +59,7 @@ void Viewer::draw_choices() {
   bool first = true;
   for (const TechniqueInfo& t : techniques()) {
     if (t.id == TechniqueId::kFur && scene_.mesh.name != "tile") continue;
+    if (t.id == TechniqueId::kPathtrace) continue;  // not in the viewer yet (issue 35, part 4)
     if (!first) ImGui::SameLine();
     first = false;
     if (ImGui::RadioButton(t.panel_label.c_str(), &technique, int(t.id))) set_technique(t.id);

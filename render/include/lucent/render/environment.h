@@ -46,6 +46,32 @@ Vec2f latlong_coordinates(const Vec3f& direction);
 /// Radiance arriving from `direction` (bilinear, wrapping in u, clamped in v).
 Vec3f environment_lookup(const EnvironmentMap& map, const Vec3f& direction);
 
+/// Directions drawn in proportion to the map's luminance (Rec. 709) times each texel's solid angle
+/// (integrated exactly over the texel's row), marginal over rows then conditional within the row,
+/// uniform in solid angle within a texel; so the density per sr is the texel's luminance over the
+/// map's integral of luminance. environment_lights draws its directions here, the path tracer its
+/// next-event estimates of the environment.
+class EnvironmentSampler {
+ public:
+  explicit EnvironmentSampler(const EnvironmentMap& map);
+
+  bool black() const { return !(total_ > 0); }  ///< no light at all: nothing to sample
+  /// The texel (i, j) and lat-long coordinates (u, v) for uniform numbers in [0, 1).
+  void pick(double xi_row, double xi_col, int& i, int& j, float& u, float& v) const;
+  /// A unit direction and its density per sr (0 only where black() is true).
+  Vec3f sample(double xi_row, double xi_col, double& pdf_sr) const;
+  /// The density per sr of drawing `direction` (need not be unit length).
+  double pdf(const Vec3f& direction) const;
+  double total() const { return total_; }  ///< the luminance integrated over the sphere
+
+ private:
+  const EnvironmentMap* map_;
+  std::vector<double> band_;                  ///< cos theta_j - cos theta_{j+1} per row
+  std::vector<std::vector<double>> row_cdf_;  ///< within each row
+  std::vector<double> marginal_;              ///< over the rows
+  double total_ = 0;
+};
+
 /// `count` directional lights that stand for the whole map: directions importance-sampled from the
 /// luminance (Rec. 709) times each texel's solid angle (the sin(theta) correction of Dal Corso 2014
 /// §4.4, integrated exactly over the texel's row), marginal over rows then conditional within the

@@ -71,6 +71,9 @@ struct Scene {
   /// Environment map shown as the background (linear RGB, lat-long), optional; its light enters
   /// through `lights` (importance-sampled directional lights).
   std::optional<std::filesystem::path> environment;
+  /// How many of `lights` (the last ones) stand for the environment map; the path tracer lights
+  /// with the map itself and skips them.
+  int environment_lights = 0;
   /// The surface's specular lobe for every light (materials/specular.h): GGX width alpha; 0 = a
   /// smooth interface (no highlight from point or directional lights). `--roughness`.
   float roughness = 0.1f;

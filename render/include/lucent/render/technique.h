@@ -15,6 +15,7 @@
 #include "lucent/materials/profile_table.h"
 #include "lucent/render/fur.h"
 #include "lucent/render/hierarchical.h"
+#include "lucent/render/path_tracer.h"
 #include "lucent/render/radiance_maps.h"
 #include "lucent/render/reference_renderer.h"
 #include "lucent/render/render_settings.h"
@@ -70,6 +71,7 @@ struct TechniqueOptions {
   hierarchical::Options hierarchical;
   fur::FurOptions fur;
   ReferenceOptions reference;
+  PathTraceOptions pathtrace;
 };
 
 /// One still image of `scene` by technique `id`: linear RGB radiance, camera.width x camera.height,

@@ -19,7 +19,7 @@
 
 namespace lucent::render {
 
-enum class TechniqueId { kMaps, kSh, kHierarchical, kFur, kReference };
+enum class TechniqueId { kMaps, kSh, kHierarchical, kFur, kReference, kPathtrace };
 
 struct TechniqueOptions;  // technique.h: every technique's options
 

@@ -1,0 +1,184 @@
+// The path tracer's pieces (path_tracer.h says what it computes): the boundary and its normals,
+// the lights as the walk sees them, one channel's random walk, and the connection through a
+// refracting boundary (refracted_connection.cpp).
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <numbers>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "lucent/materials/material.h"
+#include "lucent/render/environment.h"
+#include "lucent/render/path_tracer.h"
+#include "lucent/render/scene.h"
+#include "ray_scene.h"
+
+namespace lucent::render::pathtrace {
+
+using Vec3d = Eigen::Vector3d;
+constexpr double kPi = std::numbers::pi;
+
+/// A stream of uniform numbers in [0, 1) (SplitMix64: a counter through a strong mixer, so a path's
+/// numbers depend only on its key, never on the thread).
+class Random {
+ public:
+  explicit Random(std::uint64_t key) : state_(detail::mix(key)) {}
+  double uniform() { return double(detail::mix(state_++) >> 11) * 0x1.0p-53; }
+
+ private:
+  std::uint64_t state_;
+};
+
+/// A point on the boundary: position, the interpolated (shading) normal and the face's normal,
+/// both pointing out of the mesh, and where on which triangle.
+struct SurfacePoint {
+  Vec3d x, n, ng;
+  unsigned triangle = 0;
+  double b1 = 0, b2 = 0;  ///< barycentrics of vertices 1 and 2
+  double t = 0;           ///< distance along the ray that found it, mm
+};
+
+/// The mesh as the walk sees it: rays against the boundary, normals, a small offset.
+class Boundary {
+ public:
+  explicit Boundary(const Mesh& mesh);
+  /// The nearest boundary point along the ray, or none.
+  std::optional<SurfacePoint> hit(const Vec3d& origin, const Vec3d& direction,
+                                  double t_max = std::numeric_limits<double>::infinity()) const;
+  /// Position and outward shading normal at barycentrics (b1, b2) of a triangle (extrapolated
+  /// linearly a little outside it, for finite differences).
+  void at(unsigned triangle, double b1, double b2, Vec3d& x, Vec3d& n) const;
+  bool occluded(const Vec3d& origin, const Vec3d& direction, double distance) const;
+  /// A point moved off the surface to the side `direction` leaves toward.
+  Vec3d offset(const SurfacePoint& p, const Vec3d& direction) const {
+    return p.x + (direction.dot(p.ng) > 0 ? epsilon_ : -epsilon_) * p.ng;
+  }
+  double epsilon() const { return epsilon_; }
+
+ private:
+  const Mesh& mesh_;
+  detail::RayScene rays_;
+  double epsilon_;
+  bool flip_;  ///< the mesh's winding points its face normals inward
+};
+
+/// Henyey-Greenstein: density per sr of turning by cos_theta, and a sampled new direction.
+struct Phase {
+  double g = 0;
+  double pdf(double cos_theta) const {
+    if (std::abs(g) < 1e-4) return 1 / (4 * kPi);
+    const double d = 1 + g * g - 2 * g * cos_theta;
+    return (1 - g * g) / (4 * kPi * d * std::sqrt(d));
+  }
+  Vec3d sample(const Vec3d& direction, double xi1, double xi2) const;
+};
+
+/// One channel of the medium.
+struct Channel {
+  double sigma_t = 0, sigma_s = 0, albedo = 0;
+  Phase phase;
+};
+
+/// An emitter of the scene as the walk sees it: delta lights (directional, point), convex area
+/// polygons (emitting one-sided), and the environment map (or the constant backdrop, which is not
+/// a light: it is what the camera sees behind the object).
+struct AreaEmitter {
+  std::vector<Vec3d> polygon;
+  Vec3d normal;             ///< the side it emits toward
+  std::vector<double> cdf;  ///< fan triangles by area
+  double area = 0;
+  Vec3d radiance;
+};
+
+struct Lights {
+  std::vector<Light> delta;  ///< directional and point
+  std::vector<AreaEmitter> area;
+  std::optional<EnvironmentMap> environment;
+  std::unique_ptr<EnvironmentSampler> environment_sampler;
+  Vec3d backdrop = Vec3d::Zero();
+
+  /// The radiance a ray leaving the scene in `direction` sees (environment or backdrop), channel c.
+  double background(const Vec3d& direction, int c) const;
+};
+Lights gather_lights(const Scene& scene);
+
+/// The nearest area emitter the ray hits within t_max, with its distance; -1 if none.
+int hit_area_emitter(const Lights& lights, const Vec3d& origin, const Vec3d& direction,
+                     double t_max, double& t);
+
+/// Counts gathered per worker and summed.
+struct WalkCounts {
+  std::uint64_t paths = 0, collisions = 0, connections = 0, connection_failures = 0, truncated = 0,
+                leaks = 0, roulette_skips = 0;
+  void count(int outcome) {  // a Link
+    if (outcome == 0) ++connections;
+    if (outcome == 2) ++connection_failures;
+  }
+  void add(const WalkCounts& o) {
+    paths += o.paths, collisions += o.collisions, connections += o.connections;
+    connection_failures += o.connection_failures, truncated += o.truncated, leaks += o.leaks;
+    roulette_skips += o.roulette_skips;
+  }
+};
+
+/// Everything a path needs, shared read-only by the workers.
+struct World {
+  const Boundary& boundary;
+  const Lights& lights;
+  std::array<Channel, 3> channel;
+  double eta = 1;
+  bool matched = true;  ///< eta == 1: the boundary is invisible
+  const PathTraceOptions& options;
+  bool specular = true;  ///< the camera's own reflection off the boundary (Scene::specular)
+};
+
+/// The radiance arriving at `eye` along `direction` in channel c: one path.
+double trace_path(const World& world, int c, const Vec3d& eye, const Vec3d& direction,
+                  Random& random, WalkCounts& counts);
+
+/// The light that reaches collision x (inside) from each light, scattered toward -w_travel's
+/// reverse (the camera side: `toward` is the unit direction the path came from, reversed: where
+/// the light leaves x), before the albedo: sum over lights of phase * arriving radiance (or
+/// irradiance for delta lights) * transmittance. eta = 1 straight; eta > 1 through one refraction.
+/// `depth_to_surface`: a lower bound on the optical depth to the surface (roulette of deep
+/// estimates). MIS weights against the phase sample's escape are applied where both exist.
+double next_event(const World& world, int c, const Vec3d& x, const Vec3d& toward, Random& random,
+                  WalkCounts& counts);
+
+/// eta > 1: the boundary point y such that light from `light` refracted at y travels straight to
+/// x; the light's perpendicular irradiance there times the Fresnel transmittance and the beam's
+/// change of cross-section, the travel direction inside (unit, y -> x) and the distance |x - y|.
+/// kNone where no such path exists (the light below the surface there, something in the way),
+/// kFailed where the iteration did not converge (counted: light missed).
+struct Connection {
+  double irradiance = 0;  ///< perpendicular to the refracted beam at x, per unit light radiance
+  Vec3d travel;           ///< unit, from y to x
+  double distance = 0;    ///< mm
+  Vec3d exit;             ///< y, where the light crosses the boundary, mm
+};
+enum class Link { kConnected, kNone, kFailed };  ///< kNone: no such path (behind, blocked)
+Link refracted_connection(const World& world, const Light& light, const Vec3d& x, Connection& out);
+
+/// Refraction of travel direction d at a surface of normal n (facing the side d comes from,
+/// n . d < 0) with relative index eta_rel = n_transmitted / n_incident; false on total internal
+/// reflection.
+inline bool refract(const Vec3d& d, const Vec3d& n, double eta_rel, Vec3d& t) {
+  const double cos_i = -n.dot(d);
+  const double sin2_t = (1 - cos_i * cos_i) / (eta_rel * eta_rel);
+  if (sin2_t >= 1) return false;
+  const double cos_t = std::sqrt(1 - sin2_t);
+  t = (d / eta_rel + (cos_i / eta_rel - cos_t) * n).normalized();
+  return true;
+}
+
+inline Vec3d reflect(const Vec3d& d, const Vec3d& n) {
+  return d - 2 * d.dot(n) * n;
+}
+
+}  // namespace lucent::render::pathtrace
