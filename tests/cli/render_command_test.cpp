@@ -68,6 +68,36 @@ TEST(RenderCommand, ReferenceToPngWithStats) {
   fs::remove_all(dir);
 }
 
+TEST(RenderCommand, PathTraceWritesTheImageAndItsNoise) {
+  const auto dir = scratch_dir("render-pathtrace");
+  const fs::path out = dir / "sphere.exr", stats = dir / "stats.json";
+  const auto r = run_lucent(
+      "render --technique pathtrace --size 16x12 --view 30,20,4 --pathtrace-samples-pixel 4 "
+      "--pathtrace-threads 2 --material skin1 --mesh sphere:2 --object-size-mm 20 "
+      "--light directional:1,1,1:2,2,2 --light point:0,40,40:900,900,900 -o \"" +
+          out.string() + "\" --stats \"" + stats.string() + "\"",
+      "exr");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  ASSERT_TRUE(fs::exists(out));
+  EXPECT_NE(r.out.find("path-traced truth"), std::string::npos) << r.out;
+  const auto doc = nlohmann::json::parse(read_text(stats));
+  EXPECT_EQ(doc.at("technique"), "pathtrace");
+  const auto& d = doc.at("details");
+  EXPECT_EQ(d.at("samples_per_pixel").get<double>(), 4.0);
+  EXPECT_GT(d.at("object_pixels").get<int>(), 50);
+  for (int c = 0; c < 3; ++c) {
+    const double mean = d.at("object_mean")[c].get<double>();
+    const double error = d.at("object_mean_standard_error")[c].get<double>();
+    EXPECT_GT(mean, 0);
+    EXPECT_GT(error, 0);
+    EXPECT_LT(error, 0.2 * mean);
+  }
+  EXPECT_GT(d.at("connections").get<double>(), 0);  // skin1 eta 1.3: through the boundary
+  EXPECT_EQ(doc.at("settings"), "PathTraceOptions{samples_pixel=4, passes=1, seed=1, jitter=on}");
+  fs::remove_all(dir);
+}
+
 TEST(RenderCommand, ReferenceToExrWithPointLightAndDipole) {
   const auto dir = scratch_dir("render-exr");
   const fs::path out = dir / "sphere.exr";

@@ -235,5 +235,49 @@ TEST(PathTracer, RefractedConnectionFollowsACurvedBoundarysBeam) {
             << worst << "\n";
 }
 
+TEST(PathTracer, EveryLightTheSameThroughBothConnections) {
+  // eta = 1 reaches the lights by straight next-event estimates with MIS; eta = 1 + 1e-6 (the
+  // same light to 1e-12) takes the other road: delta and area lights through the refracted
+  // connection, area-light hits only after an internal event, the sky only by escaping. A sun,
+  // a point light, a rect light and a sky on a sphere: the two must agree within their noise.
+  const auto dir = std::filesystem::temp_directory_path() / "lucent_path_tracer_roads";
+  std::filesystem::create_directories(dir);
+  const auto sky = dir / "sky.exr";
+  ImageRgb sky_image(16, 8, 0.0f);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 16; ++x)
+      for (int c = 0; c < 3; ++c) sky_image.at(x, y, c) = float(0.2 + 0.1 * c + (y < 3 ? 0.5 : 0));
+  imaging::write_exr(sky, sky_image);
+  std::array<std::array<double, 3>, 2> mean{}, error{};
+  for (int road = 0; road < 2; ++road) {
+    Scene scene;
+    scene.mesh = load_mesh("sphere:3", 20);
+    scene.material = grey(0.05, 1.0, 0.5, road == 0 ? 1.0 : 1.0 + 1e-6);
+    scene.material.sigma_a = {0.02, 0.05, 0.2};
+    scene.lights = {parse_light("directional:0.4,0.8,0.6:0.6,0.6,0.6"),
+                    parse_light("point:-30,10,40:300,300,300"),
+                    parse_light("rect:20,-5,30:0,4,0:3,0,-2:40,40,40")};
+    scene.environment = sky;
+    scene.specular = false;
+    scene.camera = orbit_camera(scene.mesh, 20, 10, 3, 12, 12);
+    PathTraceOptions o;
+    o.pixel_samples = 96;
+    o.threads = 2;
+    o.seed = 11 + std::uint64_t(road);
+    const PathTraceImage r = render_pathtrace(scene, o);
+    mean[std::size_t(road)] = r.object_mean;
+    error[std::size_t(road)] = r.object_mean_error;
+    EXPECT_EQ(r.stats.details["connection_failures"].get<std::uint64_t>(), 0u);
+  }
+  for (std::size_t c = 0; c < 3; ++c) {
+    const double both = std::hypot(error[0][c], error[1][c]);
+    EXPECT_NEAR(mean[1][c], mean[0][c], 4 * both) << "channel " << c;
+    EXPECT_LT(both, 0.03 * mean[0][c]) << "channel " << c;
+    std::cout << "[ measured ] channel " << c << ": straight " << mean[0][c] << " +- "
+              << error[0][c] << ", through the boundary " << mean[1][c] << " +- " << error[1][c]
+              << " (ratio " << mean[1][c] / mean[0][c] << ")\n";
+  }
+}
+
 }  // namespace
 }  // namespace lucent::render
