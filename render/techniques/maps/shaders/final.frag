@@ -130,7 +130,7 @@ void main() {
   float F_r = fresnel_reflectance(dot(n_o, w_o), u_eta);
   vec3 L = (1.0 - F_r) * L_ss;
   // The mirror direction's light crosses a fur coat too (cos_i = cos_o there; T = 1 without one).
-  if (u_has_environment) {
+  if (u_has_environment && u_specular) {  // --specular off: the subsurface term alone
     L += F_r * fur_coat(dot(n_o, w_o)) * environment_lookup(u_environment, reflect(-w_o, n_o));
   }
   L += specular_lights(x_o, n_o, w_o);
