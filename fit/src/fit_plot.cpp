@@ -268,10 +268,13 @@ void write_fit_plot(const std::filesystem::path& path, const FitResult& result,
           res.y.push_back(std::log(m / v) * v / se);
         }
       }
-      // The curve: 300 radii, evenly spaced on the r axis as drawn.
+      // The curve: 300 radii over the data's, evenly spaced on the r axis as drawn. Not from r = 0:
+      // the tabulated and dipole profiles diverge there (a y axis to 1e16).
       const bool log = options.log_r && std::isfinite(r_min);
-      for (int k = 0; k <= 300 && r_max > 0; ++k) {
-        const double r = log ? r_min * std::pow(r_max / r_min, k / 300.0) : r_max * k / 300.0;
+      const double r_lo = std::isfinite(r_min) ? r_min : 0;
+      for (int k = 0; k <= 300 && r_max > r_lo; ++k) {
+        const double r =
+            log ? r_min * std::pow(r_max / r_min, k / 300.0) : r_lo + (r_max - r_lo) * k / 300.0;
         curve.x.push_back(r);
         curve.y.push_back(predicted_radial(f, data, c, r, result.table.get()));
       }
