@@ -117,6 +117,11 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
                   "on or off: the lights' specular lobe (off: the subsurface term alone, for "
                   "comparing techniques)")
       ->capture_default_str();
+  cmd->add_option("--single-scattering", args->single_scattering,
+                  "auto, on or off: the single-scattering term (Jensen et al. 2001) beside the "
+                  "BSSRDF's multiple scattering, in the techniques that have it (auto: where "
+                  "they do: the reference; the path tracer's transport always holds it)")
+      ->capture_default_str();
   cmd->add_option("--backdrop", args->backdrop,
                   "R,G,B: radiance of the background where there is no environment map "
                   "(default black)");
@@ -210,6 +215,19 @@ void check_options(SceneArguments& args, const render::TechniqueInfo& technique)
     o.fur.undercoat.hairs = int(std::lround(2400 * scale));
     o.fur.validate();
   }
+  if (args.single_scattering != "auto" && args.single_scattering != "on" &&
+      args.single_scattering != "off") {
+    throw Error("--single-scattering: expected auto, on or off, got '" + args.single_scattering +
+                "'");
+  }
+  if (args.single_scattering == "on" && !technique.single_scattering) {
+    throw Error("--single-scattering: the " + technique.name +
+                " technique has no single-scattering term yet; use --single-scattering off or auto");
+  }
+  if (args.single_scattering == "off" && technique.id == render::TechniqueId::kPathtrace) {
+    throw Error("--single-scattering: the path tracer's transport always holds single "
+                "scattering; leave the option out");
+  }
   if (args.specular != "on" && args.specular != "off") {
     throw Error("--specular: expected on or off, got '" + args.specular + "'");
   }
@@ -291,6 +309,7 @@ SceneSetup build_scene(SceneArguments& args) {
   }
   scene.roughness = args.roughness;
   scene.specular = args.specular == "on";
+  scene.single_scattering = args.single_scattering != "off" && technique.single_scattering;
   scene.backdrop = backdrop;
   if (args.fur_coat == "on")
     scene.fur_coat = render::fur::make_fur_coat(render::fur::over_mesh(o.fur));

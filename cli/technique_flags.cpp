@@ -235,6 +235,9 @@ void add_reference_flags(CLI::App* cmd, render::ReferenceOptions& o) {
   choice(cmd, g, "--reference-irradiance-cache", "--irradiance-cache", o.irradiance_cache, kOnOff,
          "probes: on: area lights' irradiance from per-cluster projection maps (Jacob 1993; "
          "bilinear between grid vertices evaluated once) instead of shadow rays at every hit");
+  flag(cmd, g, "--reference-single-samples", "", o.single_samples,
+       "collisions drawn on each pixel's refracted view ray per pass (the single-scattering term)",
+       whole_in(1, 1000000, "collisions per pixel"));
   flag(cmd, g, "--reference-passes", "--passes", o.passes,
        "progressive passes, each with new samples (image = their mean)",
        whole_in(1, 1000000, "passes"));

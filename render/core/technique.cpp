@@ -54,11 +54,12 @@ const std::vector<TechniqueInfo>& techniques() {
        "coat of shells over the maps' skin: an extension)",
        true, all, "", true, true, false, &make<FurRenderer>},
       {TechniqueId::kReference, "reference", "CPU reference", "CPU reference",
-       "reference (CPU, slow, exact up to sampling noise)", true, all, "", false, true, false},
+       "reference (CPU, slow, exact up to sampling noise)", true, all, "", false, true, false,
+       nullptr, true},
       {TechniqueId::kPathtrace, "pathtrace", "path-traced truth", "path tracer",
        "pathtrace (CPU volumetric path tracing of the medium behind its smooth boundary: the "
        "truth the others are held to; no diffusion model, --model is ignored)",
-       true, all, "traces the medium itself", false, false, false},
+       true, all, "traces the medium itself", false, false, false, nullptr, true},
   };
   return table;
 }

@@ -71,21 +71,10 @@ PathTraceImage render_pathtrace(const Scene& scene, const PathTraceOptions& opti
 
   const pathtrace::Boundary boundary(scene.mesh);
   const pathtrace::Lights lights = pathtrace::gather_lights(scene);
-  const double eta = scene.material.medium(0).eta;
-  pathtrace::World world{boundary, lights,        {}, eta, std::abs(eta - 1) < 1e-12,
-                         options,  scene.specular};
-  for (int c = 0; c < 3; ++c) {
-    const materials::Medium<double> m = scene.material.medium(c);
-    if (std::abs(m.eta - eta) > 1e-12) {
-      throw Error("pathtrace: the channels' refractive indices differ (" + std::to_string(m.eta) +
-                  " and " + std::to_string(eta) + ")");
-    }
-    pathtrace::Channel& ch = world.channel[std::size_t(c)];
-    ch.sigma_s = m.sigma_s;
-    ch.sigma_t = m.sigma_a + m.sigma_s;
-    ch.albedo = ch.sigma_t > 0 ? m.sigma_s / ch.sigma_t : 0;
-    ch.phase.g = m.g;
-  }
+  double eta = 1;
+  const std::array<pathtrace::Channel, 3> channels = pathtrace::channels_of(scene.material, eta);
+  const pathtrace::World world{boundary, lights,  channels, eta, std::abs(eta - 1) < 1e-12,
+                               options,  scene.specular};
   const PathTraceOptions& o = options;
   const CameraRays rays(camera);
   const std::size_t pixels = std::size_t(camera.width) * std::size_t(camera.height);

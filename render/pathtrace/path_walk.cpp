@@ -4,6 +4,7 @@
 // ends it.
 #include <algorithm>
 
+#include "lucent/core/error.h"
 #include "lucent/materials/fresnel.h"
 #include "path_walk.h"
 
@@ -70,7 +71,10 @@ double straight_delta(const World& w, const Channel& ch, const Light& light, con
 }  // namespace
 
 double next_event(const World& w, int c, const Vec3d& x, const Vec3d& toward, Random& random,
-                  WalkCounts& counts) {
+                  WalkCounts& counts, bool escapes) {
+  const auto share = [escapes](double mine, double other) {
+    return escapes ? balance(mine, other) : 1.0;
+  };
   const Channel& ch = w.channel[std::size_t(c)];
   double sum = 0;
   for (const Light& light : w.lights.delta) {
@@ -101,7 +105,7 @@ double next_event(const World& w, int c, const Vec3d& x, const Vec3d& toward, Ra
       const double tau = ch.sigma_t * inside_length(w.boundary, x, to_light, distance);
       const double p_light = distance * distance / (cos_light * e.area);  // per sr
       const double phase = ch.phase.pdf(-to_light.dot(toward));
-      sum += value * phase * std::exp(-tau) / p_light * balance(p_light, phase);
+      sum += value * phase * std::exp(-tau) / p_light * share(p_light, phase);
       continue;
     }
     // Through the refracting boundary: the point y as a point light of intensity L cos A.
@@ -127,10 +131,48 @@ double next_event(const World& w, int c, const Vec3d& x, const Vec3d& toward, Ra
       const double tau =
           ch.sigma_t * inside_length(w.boundary, x, dir, std::numeric_limits<double>::infinity());
       const double phase = ch.phase.pdf(-dir.dot(toward));
-      sum += w.lights.background(dir, c) * phase * std::exp(-tau) / pdf * balance(pdf, phase);
+      sum += w.lights.background(dir, c) * phase * std::exp(-tau) / pdf * share(pdf, phase);
     }
   }
   return sum;
+}
+
+double single_scattering(const World& w, int c, const SurfacePoint& p, const Vec3d& w_o,
+                         Random& random, WalkCounts& counts) {
+  const Channel& ch = w.channel[std::size_t(c)];
+  Vec3d n = p.n;
+  if (!(w_o.dot(n) > 0)) n = p.ng;
+  const double cos_o = w_o.dot(n);
+  if (!(cos_o > 0) || !(ch.sigma_t > 0)) return 0;
+  Vec3d t;
+  if (!refract(-w_o, n, w.eta, t) || !(t.dot(p.ng) < 0)) return 0;
+  const double along = w.boundary.epsilon() / std::max(std::abs(t.dot(p.ng)), 0.01);
+  const auto far = w.boundary.hit(p.x + along * t, t);
+  if (!far) return 0;
+  const double s = -std::log(1 - random.uniform()) / ch.sigma_t;
+  if (s >= along + far->t) return 0;  // no collision before the far side
+  const Vec3d x = p.x + s * t;
+  const double transmitted = 1 - materials::fresnel_reflectance(cos_o, w.eta);
+  return transmitted / (w.eta * w.eta) * ch.albedo *
+         next_event(w, c, x, -t, random, counts, false);
+}
+
+std::array<Channel, 3> channels_of(const materials::Material& material, double& eta) {
+  std::array<Channel, 3> channels;
+  eta = material.medium(0).eta;
+  for (int c = 0; c < 3; ++c) {
+    const materials::Medium<double> m = material.medium(c);
+    if (std::abs(m.eta - eta) > 1e-12) {
+      throw Error("pathtrace: the channels' refractive indices differ (" + std::to_string(m.eta) +
+                  " and " + std::to_string(eta) + ")");
+    }
+    Channel& ch = channels[std::size_t(c)];
+    ch.sigma_s = m.sigma_s;
+    ch.sigma_t = m.sigma_a + m.sigma_s;
+    ch.albedo = ch.sigma_t > 0 ? m.sigma_s / ch.sigma_t : 0;
+    ch.phase.g = m.g;
+  }
+  return channels;
 }
 
 double trace_path(const World& w, int c, const Vec3d& eye, const Vec3d& direction, Random& random,

@@ -142,14 +142,26 @@ struct World {
 double trace_path(const World& world, int c, const Vec3d& eye, const Vec3d& direction,
                   Random& random, WalkCounts& counts);
 
-/// The light that reaches collision x (inside) from each light, scattered toward -w_travel's
-/// reverse (the camera side: `toward` is the unit direction the path came from, reversed: where
-/// the light leaves x), before the albedo: sum over lights of phase * arriving radiance (or
-/// irradiance for delta lights) * transmittance. eta = 1 straight; eta > 1 through one refraction.
-/// `depth_to_surface`: a lower bound on the optical depth to the surface (roulette of deep
-/// estimates). MIS weights against the phase sample's escape are applied where both exist.
+/// The light that reaches collision x (inside) from every light and leaves it along `toward` (unit:
+/// the direction back along the path, toward the camera side), before the albedo: the sum over
+/// lights of phase x arriving radiance (irradiance for delta lights) x transmittance. eta = 1
+/// straight, eta > 1 through one refraction. `escapes`: the path's escaping rays also count the
+/// environment and area lights, so the two strategies share them by MIS weights; without escapes
+/// (single scattering alone) each estimate is whole.
 double next_event(const World& world, int c, const Vec3d& x, const Vec3d& toward, Random& random,
-                  WalkCounts& counts);
+                  WalkCounts& counts, bool escapes = true);
+
+/// The single-scattering radiance leaving boundary point p toward w_o (unit, toward the eye),
+/// channel c: one collision on the refracted view ray (drawn from sigma_t e^(-sigma_t s), none
+/// past the far boundary) with its next-event estimate of every light, times the Fresnel
+/// transmittance out and 1 / eta^2. Jensen et al. 2001's single-scattering term (their eq. 9), with
+/// the exact refracted light path (the connection) in place of their planar approximation.
+double single_scattering(const World& world, int c, const SurfacePoint& p, const Vec3d& w_o,
+                         Random& random, WalkCounts& counts);
+
+/// The medium's channels and its relative index; throws lucent::Error if the channels' indices
+/// differ.
+std::array<Channel, 3> channels_of(const materials::Material& material, double& eta);
 
 /// eta > 1: the boundary point y such that light from `light` refracted at y travels straight to
 /// x; the light's perpendicular irradiance there times the Fresnel transmittance and the beam's

@@ -23,6 +23,8 @@ void ReferenceOptions::validate() const {
   require(irradiance_cache_samples >= 1 && std::isfinite(irradiance_cache_texel_mm) &&
               irradiance_cache_texel_mm >= 0,
           "reference: the irradiance cache needs samples >= 1 and a texel size >= 0 mm");
+  require(single_samples >= 1 && single_samples <= 1000000,
+          "--reference-single-samples: expected 1..1000000, got " + std::to_string(single_samples));
   require(std::isfinite(exposure) && exposure > 0, "reference: the exposure must be positive");
   require(cluster_ratio >= 0 && cluster_ratio < 1, "reference: cluster_ratio must be in [0, 1)");
 }
@@ -39,7 +41,8 @@ std::string ReferenceOptions::to_string() const {
     << ", shadows=" << shadows << ", area_light_samples=" << area_light_samples
     << ", area_light_control_variate=" << area_light_control_variate
     << ", irradiance_cache=" << irradiance_cache << ", cluster_ratio=" << cluster_ratio
-    << ", environment_reflection=" << environment_reflection << "}";
+    << ", environment_reflection=" << environment_reflection
+    << ", single_samples=" << single_samples << "}";
   return s.str();
 }
 

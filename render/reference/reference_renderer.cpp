@@ -25,6 +25,7 @@
 #include "lucent/materials/specular.h"
 #include "lucent/render/environment.h"
 #include "reference_common.h"
+#include "reference_single.h"
 
 namespace lucent::render {
 namespace {
@@ -254,6 +255,7 @@ class ReferenceRun {
 
   ReferenceImage run() {
     trace_primary_rays();
+    if (scene.single_scattering) single_term = std::make_unique<SingleScatteringTerm>(scene);
     prepare_lights();
     work_total = double(options.passes) * double(std::max<std::size_t>(groups, 1)) *
                  double(std::max<std::size_t>(object_pixels.size(), 1));
@@ -264,7 +266,14 @@ class ReferenceRun {
       } else {
         area_samples(pass, accumulated);
       }
-      fold_pass(pass, accumulated);
+      std::vector<std::array<double, 3>> single;
+      if (single_term) {
+        const auto single_start = Clock::now();
+        single = single_term->pass(hits, object_pixels, options.single_samples, options.seed,
+                                   pass, threads);
+        single_ms += ms_since(single_start);
+      }
+      fold_pass(pass, accumulated, single);
     }
     result.image = mean;
     fill_stats();
@@ -276,7 +285,8 @@ class ReferenceRun {
   void prepare_lights();
   void probes(int pass, std::vector<std::array<double, 3>>& accumulated);
   void area_samples(int pass, std::vector<std::array<double, 3>>& accumulated);
-  void fold_pass(int pass, const std::vector<std::array<double, 3>>& accumulated);
+  void fold_pass(int pass, const std::vector<std::array<double, 3>>& accumulated,
+                 const std::vector<std::array<double, 3>>& single);
   void fill_stats();
 
   const Clock::time_point start = Clock::now();
@@ -314,6 +324,8 @@ class ReferenceRun {
   double work_total = 0;
   std::mutex progress_mutex;
   std::uint64_t probe_hits = 0;
+  std::unique_ptr<SingleScatteringTerm> single_term;
+  double single_ms = 0;
 };
 
 void ReferenceRun::trace_primary_rays() {
@@ -506,7 +518,8 @@ void ReferenceRun::area_samples(int pass, std::vector<std::array<double, 3>>& ac
 }
 
 // The pass's image (subsurface, environment reflection, specular), folded into the running mean.
-void ReferenceRun::fold_pass(int pass, const std::vector<std::array<double, 3>>& accumulated) {
+void ReferenceRun::fold_pass(int pass, const std::vector<std::array<double, 3>>& accumulated,
+                             const std::vector<std::array<double, 3>>& single) {
   ImageRgb image = background;
   for (std::size_t i = 0; i < object_pixels.size(); ++i) {
     const std::size_t p = object_pixels[i];
@@ -521,8 +534,9 @@ void ReferenceRun::fold_pass(int pass, const std::vector<std::array<double, 3>>&
     const Vec3f specular = specular_radiance(
         scene, rays, hit, eps, mix(options.seed ^ (std::uint64_t(pass) << 40) ^ std::uint64_t(p)));
     for (int c = 0; c < 3; ++c) {
-      image.data[3 * p + c] =
-          float(hit.fresnel_out * accumulated[i][c]) + reflection[c] + specular[c];
+      image.data[3 * p + c] = float(hit.fresnel_out * accumulated[i][c] +
+                                    (single.empty() ? 0.0 : single[i][std::size_t(c)])) +
+                              reflection[c] + specular[c];
     }
   }
   const float blend = 1.0f / float(pass + 1);
@@ -541,6 +555,7 @@ void ReferenceRun::fill_stats() {
                    {"surface samples and shadow rays", sampling_ms},
                    {"cluster trees", tree_ms},
                    {"gather", gather_ms}};
+  if (single_term) stats.pass_ms.emplace_back("single scattering", single_ms);
   stats.total_ms = ms_since(start);
   stats.details = {{"model", materials::to_string(model)},
                    {"sampling", to_string(options.sampling)},
@@ -557,6 +572,10 @@ void ReferenceRun::fill_stats() {
                    {"shadows", options.shadows},
                    {"threads", threads},
                    {"seed", options.seed},
+                   {"single_scattering", single_term != nullptr},
+                   {"single_samples_per_pass", single_term ? options.single_samples : 0},
+                   {"single_connection_failures",
+                    single_term ? single_term->connection_failures() : 0},
                    {"cutoff_mm",
                     {std::isinf(r_cut[0]) ? -1.0 : r_cut[0], std::isinf(r_cut[1]) ? -1.0 : r_cut[1],
                      std::isinf(r_cut[2]) ? -1.0 : r_cut[2]}}};

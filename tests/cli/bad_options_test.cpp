@@ -79,6 +79,12 @@ std::vector<BadCase> option_cases() {
       {"render_samples_zero", nullptr, ren + "--reference-samples-pixel 0",
        "--reference-samples-pixel"},
       {"render_passes_zero", nullptr, ren + "--reference-passes 0", "--reference-passes"},
+      {"render_single_scattering_foo", nullptr, ren + "--single-scattering foo",
+       "--single-scattering"},
+      {"render_single_scattering_maps", nullptr,
+       ren.substr(0, ren.find("--technique")) + "--technique maps --single-scattering on " +
+           ren.substr(ren.find("--technique") + 22),
+       "--single-scattering"},
       {"render_pathtrace_samples_zero", nullptr, ren + "--pathtrace-samples-pixel 0",
        "--pathtrace-samples-pixel"},
       {"render_pathtrace_passes_zero", nullptr, ren + "--pathtrace-passes 0", "--pathtrace-passes"},

@@ -64,6 +64,7 @@ TEST(RenderCommand, ReferenceToPngWithStats) {
   EXPECT_EQ(doc.at("width"), 24);
   EXPECT_EQ(doc.at("height"), 20);
   EXPECT_EQ(doc.at("scene").at("model"), "tabulated");  // an unfitted material inside the table
+  EXPECT_EQ(doc.at("details").at("single_scattering"), true);  // --single-scattering auto
   EXPECT_GT(doc.at("total_ms").get<double>(), 0);
   fs::remove_all(dir);
 }

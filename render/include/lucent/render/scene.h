@@ -78,6 +78,10 @@ struct Scene {
   /// smooth interface (no highlight from point or directional lights). `--roughness`.
   float roughness = 0.1f;
   bool specular = true;  ///< `--specular off` renders the subsurface term alone
+  /// Add the single-scattering term (Jensen et al. 2001) beside the BSSRDF's multiple scattering,
+  /// in the techniques that have one (technique.h: TechniqueInfo::single_scattering). The CLI's
+  /// `--single-scattering` turns it on by default; a Scene made in code has the BSSRDF alone.
+  bool single_scattering = false;
   Vec3f backdrop{0, 0, 0};  ///< radiance of the background where no environment map is given
   /// A fur coat over the skin (fur_coat.h, an extension of Klotzli & Olano): the maps and the
   /// reference attenuate each light sample's transmitted irradiance by its T(n . w_i). `--fur-coat

@@ -42,6 +42,9 @@ struct TechniqueInfo {
   /// Makes the technique's frame-by-frame renderer (technique_base.h); null for the CPU reference,
   /// which renders stills only.
   std::unique_ptr<Technique> (*make)() = nullptr;
+  /// Adds the single-scattering term (Scene::single_scattering) beside its multiple scattering;
+  /// the path tracer's transport always holds it.
+  bool single_scattering = false;
 
   bool supports(materials::DiffusionModel model) const;
 };
