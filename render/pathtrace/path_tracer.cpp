@@ -13,12 +13,12 @@ namespace {
 
 using pathtrace::Vec3d;
 
-// The key of sample k of pixel p in pass `pass`, channel c: the same whatever thread draws it.
-std::uint64_t sample_key(std::uint64_t seed, int pass, std::size_t pixel, int k, int c) {
+// The key of sample k of pixel p in pass `pass`: the same whatever thread draws it.
+std::uint64_t sample_key(std::uint64_t seed, int pass, std::size_t pixel, int k) {
   std::uint64_t key = detail::mix(seed ^ 0x5bd1e995u);
   key = detail::mix(key + std::uint64_t(pass));
   key = detail::mix(key + pixel);
-  return detail::mix(key + (std::uint64_t(k) << 2) + std::uint64_t(c));
+  return detail::mix(key + std::uint64_t(k));
 }
 
 struct CameraRays {
@@ -72,10 +72,11 @@ PathTraceImage render_pathtrace(const Scene& scene, const PathTraceOptions& opti
   const pathtrace::Boundary boundary(scene.mesh);
   const pathtrace::Lights lights = pathtrace::gather_lights(scene);
   double eta = 1;
-  const std::array<pathtrace::Channel, 3> channels = pathtrace::channels_of(scene.material, eta);
-  const pathtrace::World world{boundary, lights,  channels, eta, std::abs(eta - 1) < 1e-12,
+  const pathtrace::MediumRgb medium = pathtrace::medium_of(scene.material, eta);
+  const pathtrace::World world{boundary, lights,        medium, eta, std::abs(eta - 1) < 1e-12,
                                options,  scene.specular};
   const PathTraceOptions& o = options;
+  const std::vector<pathtrace::Rgb> groups = pathtrace::channel_groups(medium);
   const CameraRays rays(camera);
   const std::size_t pixels = std::size_t(camera.width) * std::size_t(camera.height);
   const int threads =
@@ -99,14 +100,17 @@ PathTraceImage render_pathtrace(const Scene& scene, const PathTraceOptions& opti
           pathtrace::WalkCounts mine;
           for (std::size_t p = begin; p < end; ++p) {
             for (int k = 0; k < o.pixel_samples; ++k) {
-              for (int c = 0; c < 3; ++c) {
-                pathtrace::Random random(sample_key(o.seed, pass, p, k, c));
+              pathtrace::Rgb v = pathtrace::Rgb::Zero();
+              for (std::size_t g = 0; g < groups.size(); ++g) {
+                pathtrace::Random random(sample_key(o.seed, pass, p, k) + g);
                 const double fx = o.jitter ? random.uniform() : 0.5;
                 const double fy = o.jitter ? random.uniform() : 0.5;
-                const double v = pathtrace::trace_path(world, c, rays.eye,
-                                                       rays.direction(p, fx, fy), random, mine);
-                moments[p][std::size_t(c)] += v;
-                moments[p][3 + std::size_t(c)] += v * v;
+                v += pathtrace::trace_path(world, rays.eye, rays.direction(p, fx, fy), groups[g],
+                                           random, mine);
+              }
+              for (std::size_t c = 0; c < 3; ++c) {
+                moments[p][c] += v[int(c)];
+                moments[p][3 + c] += v[int(c)] * v[int(c)];
               }
             }
           }
@@ -173,6 +177,7 @@ PathTraceImage render_pathtrace(const Scene& scene, const PathTraceOptions& opti
                                                       (value_sum / (3.0 * double(object)))
                                                 : 0.0},
                    {"eta", eta},
+                   {"paths_per_sample", groups.size()},
                    {"connection", world.matched ? "straight (eta = 1)" : "through one refraction"}};
   return result;
 }

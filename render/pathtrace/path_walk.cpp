@@ -1,7 +1,7 @@
-// One channel's path (path_walk.h): from the camera through the boundary's Fresnel events into the
-// medium, collision after collision (free paths drawn from sigma_t, Henyey-Greenstein turns), with
-// next-event estimates of every light at every collision, until it leaves the scene or roulette
-// ends it.
+// One path (path_walk.h), the three channels together: from the camera through the boundary's
+// Fresnel events into the medium, collision after collision (free paths drawn from the channels'
+// mixture, Henyey-Greenstein turns), with next-event estimates of every light at every collision,
+// until it leaves the scene or roulette ends it.
 #include <algorithm>
 
 #include "lucent/core/error.h"
@@ -50,9 +50,26 @@ double balance(double mine, double other) {
   return mine / (mine + other);
 }
 
+// The channels' shares of a sample: their throughputs, normalised (equal where all are 0).
+Rgb shares_of(const Rgb& beta) {
+  const double sum = beta.sum();
+  return sum > 0 ? Rgb(beta / sum) : Rgb::Constant(1.0 / 3);
+}
+
+// A channel picked in proportion to `share`.
+int pick_channel(const Rgb& share, double xi) {
+  if (xi < share[0]) return 0;
+  return xi < share[0] + share[1] ? 1 : 2;
+}
+
+// The phase sample's density under the channels' mixture, and its direction.
+double mixture_phase_pdf(const MediumRgb& m, const Rgb& share, double cos_theta) {
+  if (m.one_phase) return m.phase[0].pdf(cos_theta);
+  return (share * m.phase_pdf(cos_theta)).sum();
+}
+
 // A delta light straight through an invisible boundary: phase x irradiance x transmittance.
-double straight_delta(const World& w, const Channel& ch, const Light& light, const Vec3d& x,
-                      const Vec3d& toward) {
+Rgb straight_delta(const World& w, const Light& light, const Vec3d& x, const Vec3d& toward) {
   Vec3d to_light;
   double distance = std::numeric_limits<double>::infinity(), falloff = 1;
   if (light.type == LightType::kDirectional) {
@@ -60,41 +77,47 @@ double straight_delta(const World& w, const Channel& ch, const Light& light, con
   } else {
     to_light = light.position.cast<double>() - x;
     distance = to_light.norm();
-    if (!(distance > 0)) return 0;
+    if (!(distance > 0)) return Rgb::Zero();
     to_light /= distance;
     falloff = 1 / (distance * distance);
   }
-  const double tau = ch.sigma_t * inside_length(w.boundary, x, to_light, distance);
-  return ch.phase.pdf(-to_light.dot(toward)) * falloff * std::exp(-tau);
+  const double length = inside_length(w.boundary, x, to_light, distance);
+  return w.medium.phase_pdf(-to_light.dot(toward)) * falloff * (-w.medium.sigma_t * length).exp();
+}
+
+Rgb radiance_of(const Vec3f& v) {
+  return v.cast<double>().array();
 }
 
 }  // namespace
 
-double next_event(const World& w, int c, const Vec3d& x, const Vec3d& toward, Random& random,
-                  WalkCounts& counts, bool escapes) {
-  const auto share = [escapes](double mine, double other) {
-    return escapes ? balance(mine, other) : 1.0;
+Rgb next_event(const World& w, const Vec3d& x, const Vec3d& toward, Random& random,
+               WalkCounts& counts, const Rgb* share) {
+  const MediumRgb& m = w.medium;
+  // MIS against the phase sample's escape where it also counts (eta = 1 and the path goes on).
+  const auto weight = [&](double mine, const Vec3d& direction) {
+    if (share == nullptr) return 1.0;
+    return balance(mine, mixture_phase_pdf(m, *share, direction.dot(-toward)));
   };
-  const Channel& ch = w.channel[std::size_t(c)];
-  double sum = 0;
+  Rgb sum = Rgb::Zero();
   for (const Light& light : w.lights.delta) {
-    const double value = light.radiance[c];
-    if (!(value > 0)) continue;
+    const Rgb value = radiance_of(light.radiance);
+    if (!(value.maxCoeff() > 0)) continue;
     if (w.matched) {
-      sum += value * straight_delta(w, ch, light, x, toward);
+      sum += value * straight_delta(w, light, x, toward);
       continue;
     }
     Connection link;
     const Link outcome = refracted_connection(w, light, x, link);
     counts.count(int(outcome));
     if (outcome == Link::kConnected) {
-      sum += value * ch.phase.pdf(link.travel.dot(toward)) * link.irradiance *
-             std::exp(-ch.sigma_t * link.distance);
+      sum += value * m.phase_pdf(link.travel.dot(toward)) * link.irradiance *
+             (-m.sigma_t * link.distance).exp();
     }
   }
   for (const AreaEmitter& e : w.lights.area) {
-    const double value = e.radiance[c];
-    if (!(value > 0)) continue;
+    const Rgb value = e.radiance.array();
+    if (!(value.maxCoeff() > 0)) continue;
     const Vec3d y = sample_area(e, random);
     if (w.matched) {
       Vec3d to_light = y - x;
@@ -102,10 +125,10 @@ double next_event(const World& w, int c, const Vec3d& x, const Vec3d& toward, Ra
       to_light /= distance;
       const double cos_light = -to_light.dot(e.normal);
       if (!(cos_light > 0)) continue;
-      const double tau = ch.sigma_t * inside_length(w.boundary, x, to_light, distance);
+      const double length = inside_length(w.boundary, x, to_light, distance);
       const double p_light = distance * distance / (cos_light * e.area);  // per sr
-      const double phase = ch.phase.pdf(-to_light.dot(toward));
-      sum += value * phase * std::exp(-tau) / p_light * share(p_light, phase);
+      sum += value * m.phase_pdf(-to_light.dot(toward)) * (-m.sigma_t * length).exp() / p_light *
+             weight(p_light, to_light);
       continue;
     }
     // Through the refracting boundary: the point y as a point light of intensity L cos A.
@@ -118,8 +141,8 @@ double next_event(const World& w, int c, const Vec3d& x, const Vec3d& toward, Ra
     if (outcome == Link::kConnected) {
       const double cos_light = (link.exit - y).normalized().dot(e.normal);
       if (cos_light > 0) {
-        sum += value * cos_light * e.area * ch.phase.pdf(link.travel.dot(toward)) *
-               link.irradiance * std::exp(-ch.sigma_t * link.distance);
+        sum += value * cos_light * e.area * m.phase_pdf(link.travel.dot(toward)) * link.irradiance *
+               (-m.sigma_t * link.distance).exp();
       }
     }
   }
@@ -128,37 +151,64 @@ double next_event(const World& w, int c, const Vec3d& x, const Vec3d& toward, Ra
     const Vec3d dir = w.lights.environment_sampler->sample(random.uniform(), random.uniform(), pdf)
                           .cast<double>();
     if (pdf > 0) {
-      const double tau =
-          ch.sigma_t * inside_length(w.boundary, x, dir, std::numeric_limits<double>::infinity());
-      const double phase = ch.phase.pdf(-dir.dot(toward));
-      sum += w.lights.background(dir, c) * phase * std::exp(-tau) / pdf * share(pdf, phase);
+      const double length =
+          inside_length(w.boundary, x, dir, std::numeric_limits<double>::infinity());
+      const Rgb sky(w.lights.background(dir, 0), w.lights.background(dir, 1),
+                    w.lights.background(dir, 2));
+      sum += sky * m.phase_pdf(-dir.dot(toward)) * (-m.sigma_t * length).exp() / pdf *
+             weight(pdf, dir);
     }
   }
   return sum;
 }
 
-double single_scattering(const World& w, int c, const SurfacePoint& p, const Vec3d& w_o,
-                         Random& random, WalkCounts& counts) {
-  const Channel& ch = w.channel[std::size_t(c)];
+namespace {
+
+// A free path from a surface point (or a collision) drawn from the channels' mixture: true and the
+// distance s when it ends in a collision before `boundary` mm, with the channels' weights
+// sigma_s e^(-sigma_t s) / mixture density folded into beta; false when it reaches the boundary
+// first, with e^(-sigma_t boundary) / the probability of getting there folded in.
+bool free_path(const MediumRgb& m, const Rgb& share, double boundary, Random& random, Rgb& beta,
+               double& s) {
+  const int k = pick_channel(share, random.uniform());
+  const double sigma = m.sigma_t[k];
+  s = sigma > 0 ? -std::log(1 - random.uniform()) / sigma : std::numeric_limits<double>::infinity();
+  if (s < boundary) {
+    const Rgb survive = (-m.sigma_t * s).exp();
+    const double pdf = (share * m.sigma_t * survive).sum();
+    beta *= m.sigma_s * survive / pdf;
+    return true;
+  }
+  const Rgb survive = (-m.sigma_t * boundary).exp();
+  beta *= survive / (share * survive).sum();
+  return false;
+}
+
+}  // namespace
+
+Rgb single_scattering(const World& w, const SurfacePoint& p, const Vec3d& w_o, Random& random,
+                      WalkCounts& counts) {
   Vec3d n = p.n;
   if (!(w_o.dot(n) > 0)) n = p.ng;
   const double cos_o = w_o.dot(n);
-  if (!(cos_o > 0) || !(ch.sigma_t > 0)) return 0;
+  if (!(cos_o > 0) || !(w.medium.sigma_t.maxCoeff() > 0)) return Rgb::Zero();
   Vec3d t;
-  if (!refract(-w_o, n, w.eta, t) || !(t.dot(p.ng) < 0)) return 0;
+  if (!refract(-w_o, n, w.eta, t) || !(t.dot(p.ng) < 0)) return Rgb::Zero();
   const double along = w.boundary.epsilon() / std::max(std::abs(t.dot(p.ng)), 0.01);
   const auto far = w.boundary.hit(p.x + along * t, t);
-  if (!far) return 0;
-  const double s = -std::log(1 - random.uniform()) / ch.sigma_t;
-  if (s >= along + far->t) return 0;  // no collision before the far side
+  if (!far) return Rgb::Zero();
+  Rgb beta = Rgb::Ones();
+  double s = 0;
+  if (!free_path(w.medium, Rgb::Constant(1.0 / 3), along + far->t, random, beta, s)) {
+    return Rgb::Zero();  // no collision before the far side
+  }
   const Vec3d x = p.x + s * t;
   const double transmitted = 1 - materials::fresnel_reflectance(cos_o, w.eta);
-  return transmitted / (w.eta * w.eta) * ch.albedo *
-         next_event(w, c, x, -t, random, counts, false);
+  return transmitted / (w.eta * w.eta) * beta * next_event(w, x, -t, random, counts, nullptr);
 }
 
-std::array<Channel, 3> channels_of(const materials::Material& material, double& eta) {
-  std::array<Channel, 3> channels;
+MediumRgb medium_of(const materials::Material& material, double& eta) {
+  MediumRgb medium;
   eta = material.medium(0).eta;
   for (int c = 0; c < 3; ++c) {
     const materials::Medium<double> m = material.medium(c);
@@ -166,27 +216,62 @@ std::array<Channel, 3> channels_of(const materials::Material& material, double& 
       throw Error("pathtrace: the channels' refractive indices differ (" + std::to_string(m.eta) +
                   " and " + std::to_string(eta) + ")");
     }
-    Channel& ch = channels[std::size_t(c)];
-    ch.sigma_s = m.sigma_s;
-    ch.sigma_t = m.sigma_a + m.sigma_s;
-    ch.albedo = ch.sigma_t > 0 ? m.sigma_s / ch.sigma_t : 0;
-    ch.phase.g = m.g;
+    medium.sigma_s[c] = m.sigma_s;
+    medium.sigma_t[c] = m.sigma_a + m.sigma_s;
+    medium.phase[std::size_t(c)].g = m.g;
   }
-  return channels;
+  medium.one_phase =
+      medium.phase[0].g == medium.phase[1].g && medium.phase[0].g == medium.phase[2].g;
+  return medium;
 }
 
-double trace_path(const World& w, int c, const Vec3d& eye, const Vec3d& direction, Random& random,
-                  WalkCounts& counts) {
-  const Channel& ch = w.channel[std::size_t(c)];
+std::vector<Rgb> channel_groups(const MediumRgb& medium) {
+  std::array<int, 3> order{0, 1, 2};
+  std::sort(order.begin(), order.end(),
+            [&](int a, int b) { return medium.sigma_t[a] < medium.sigma_t[b]; });
+  const auto spread = [&](int a, int b) {
+    // While both carry weight: the shares follow the throughputs, so once the shorter-lived channel
+    // has faded the other is sampled by its own sigma_t (a weight of its albedo).
+    const double albedo = std::min(medium.sigma_s[a] / std::max(medium.sigma_t[a], 1e-300),
+                                   medium.sigma_s[b] / std::max(medium.sigma_t[b], 1e-300));
+    const double collisions = 1 / std::max(1 - albedo, 1e-6);
+    const double ratio =
+        std::log(std::max(medium.sigma_t[a], 1e-300) / std::max(medium.sigma_t[b], 1e-300));
+    return collisions * ratio * ratio;
+  };
+  std::vector<Rgb> groups;
+  for (const int c : order) {
+    bool placed = false;
+    for (Rgb& g : groups) {
+      bool fits = true;
+      for (int k = 0; k < 3; ++k)
+        if (g[k] > 0 && spread(c, k) >= 2) fits = false;
+      if (fits) {
+        g[c] = 1;
+        placed = true;
+        break;
+      }
+    }
+    if (!placed) {
+      groups.push_back(Rgb::Zero());
+      groups.back()[c] = 1;
+    }
+  }
+  return groups;
+}
+
+Rgb trace_path(const World& w, const Vec3d& eye, const Vec3d& direction, const Rgb& carried,
+               Random& random, WalkCounts& counts) {
+  const MediumRgb& m = w.medium;
   const Boundary& boundary = w.boundary;
   ++counts.paths;
-  double radiance = 0, beta = 1;
+  Rgb radiance = Rgb::Zero(), beta = carried;
   Vec3d o = eye, d = direction;
   bool inside = false;
   bool first_surface = true;  // the camera ray has not met the boundary yet
   bool scattered = false;     // a collision happened
   int chain = 0;              // boundary events since the last collision
-  double phase_pdf = 0;       // density of d at the last collision (per sr)
+  double phase_pdf = 0;       // density of d at the last collision (per sr, the mixture's)
   Vec3d last = eye;           // the last collision
   int collisions = 0;
   // Inside, a ray starts a little off the surface point it left (so as not to hit its own face
@@ -197,6 +282,10 @@ double trace_path(const World& w, int c, const Vec3d& eye, const Vec3d& directio
   const auto step_in = [&](const SurfacePoint& p, const Vec3d& dir, double& along) {
     along = boundary.epsilon() / std::max(std::abs(dir.dot(p.ng)), 0.01);
     return Vec3d(p.x + along * dir);
+  };
+  const auto sky = [&](const Vec3d& dir) {
+    return Rgb(w.lights.background(dir, 0), w.lights.background(dir, 1),
+               w.lights.background(dir, 2));
   };
 
   for (;;) {
@@ -216,17 +305,17 @@ double trace_path(const World& w, int c, const Vec3d& eye, const Vec3d& directio
         } else if (scattered && chain == 1) {
           weight = 0;  // collision, refraction out, light: the refracted connection's path
         }
-        radiance += beta * weight * e.radiance[c];
+        radiance += beta * weight * e.radiance.array();
       }
       if (!hit) {
         if (!scattered) {
-          radiance += beta * w.lights.background(d, c);  // what the camera sees behind
+          radiance += beta * sky(d);  // what the camera sees behind
         } else if (w.lights.environment) {
           double weight = 1;
           if (w.matched && w.lights.environment_sampler) {
             weight = balance(phase_pdf, w.lights.environment_sampler->pdf(d.cast<float>()));
           }
-          radiance += beta * weight * w.lights.background(d, c);
+          radiance += beta * weight * sky(d);
         }
         return radiance;
       }
@@ -265,10 +354,9 @@ double trace_path(const World& w, int c, const Vec3d& eye, const Vec3d& directio
       ++counts.leaks;
       return radiance;
     }
-    const double s = ch.sigma_t > 0 ? -std::log(1 - random.uniform()) / ch.sigma_t
-                                    : std::numeric_limits<double>::infinity();
-    if (s < head + hit->t) {
-      // A collision: next-event estimates, then absorption (as weight) and a turn.
+    double s = 0;
+    if (free_path(m, shares_of(beta), head + hit->t, random, beta, s)) {
+      // A collision: next-event estimates, roulette, a turn.
       const Vec3d x = o + (s - head) * d;
       if (++collisions > w.options.max_collisions) {
         ++counts.truncated;
@@ -278,14 +366,20 @@ double trace_path(const World& w, int c, const Vec3d& eye, const Vec3d& directio
       scattered = true;
       chain = 0;
       last = x;
-      radiance += beta * ch.albedo * next_event(w, c, x, -d, random, counts);
-      beta *= ch.albedo;
-      if (beta < kRouletteBelow) {
-        if (random.uniform() * kRouletteBelow >= beta) return radiance;
-        beta = kRouletteBelow;
+      const Rgb share = shares_of(beta);
+      radiance += beta * next_event(w, x, -d, random, counts, &share);
+      const double top = beta.maxCoeff();
+      if (top < kRouletteBelow) {
+        if (random.uniform() * kRouletteBelow >= top) return radiance;
+        beta *= kRouletteBelow / top;
       }
-      const Vec3d turned = ch.phase.sample(d, random.uniform(), random.uniform());
-      phase_pdf = ch.phase.pdf(turned.dot(d));
+      // The turn: from the one phase, or from a channel's picked by its share (the mixture's
+      // density divides each channel's own).
+      const int k = m.one_phase ? 0 : pick_channel(share, random.uniform());
+      const Vec3d turned = m.phase[std::size_t(k)].sample(d, random.uniform(), random.uniform());
+      const double cos_turn = turned.dot(d);
+      phase_pdf = mixture_phase_pdf(m, share, cos_turn);
+      if (!m.one_phase) beta *= m.phase_pdf(cos_turn) / phase_pdf;
       d = turned;
       o = x;
       head = 0;

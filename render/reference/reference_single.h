@@ -32,7 +32,7 @@ class SingleScatteringTerm {
   const pathtrace::Lights lights_;
   const PathTraceOptions options_;
   double eta_ = 1;
-  const std::array<pathtrace::Channel, 3> channels_;
+  const pathtrace::MediumRgb medium_;
   const pathtrace::World world_;
   mutable std::uint64_t failures_ = 0;
 };

@@ -36,8 +36,8 @@
 namespace lucent::render {
 
 struct PathTraceOptions {
-  /// Paths per pixel per pass, each of the three channels its own path. Noise falls as 1 /
-  /// sqrt(samples); the statistics give the measured standard error.
+  /// Paths per pixel per pass, each carrying the three channels (spectral MIS over their free
+  /// paths). Noise falls as 1 / sqrt(samples); the statistics give the measured standard error.
   int pixel_samples = 64;
   int passes = 1;          ///< progressive: image = the mean over passes of new samples
   int threads = 0;         ///< worker threads; 0 = all hardware threads

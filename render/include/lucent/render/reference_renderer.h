@@ -59,8 +59,8 @@ struct ReferenceOptions {
   /// the analytic pi L F as a control variate (area_light_irradiance.h: unbiased either way; with
   /// it a fully visible light costs no noise). The kArea sampler always uses the plain mean.
   int area_light_samples = 4;
-  /// Scene::single_scattering: collisions drawn on each pixel's refracted view ray per pass and
-  /// channel (reference_single.h); noise falls as 1 / sqrt of it.
+  /// Scene::single_scattering: collisions drawn on each pixel's refracted view ray per pass (the
+  /// three channels together, reference_single.h); noise falls as 1 / sqrt of it.
   int single_samples = 16;
   bool area_light_control_variate = true;
   /// Area lights (kProbes): the irradiance from the per-cluster projection maps of Jacob 1993
