@@ -19,6 +19,26 @@ Boundary::Boundary(const Mesh& mesh) : mesh_(mesh), rays_(mesh) {
     agree += double(face.dot(mesh.normals[tri[0]] + mesh.normals[tri[1]] + mesh.normals[tri[2]]));
   }
   flip_ = agree < 0;
+  const double faces = double(mesh.triangles.size()), vertices = double(mesh.positions.size());
+  if (faces * vertices <= 5e7) {
+    const double tolerance = 1e-6 * (double(mesh.bounding_radius()) + 1e-9);
+    convex_ = true;
+    for (std::size_t t = 0; t < mesh.triangles.size() && convex_; ++t) {
+      const auto& tri = mesh.triangles[t];
+      const Vec3d a = mesh.positions[tri[0]].cast<double>();
+      Vec3d n = (mesh.positions[tri[1]].cast<double>() - a)
+                    .cross(mesh.positions[tri[2]].cast<double>() - a);
+      if (!(n.norm() > 0)) continue;
+      n.normalize();
+      if (flip_) n = -n;
+      for (const Vec3f& v : mesh.positions) {
+        if ((v.cast<double>() - a).dot(n) > tolerance) {
+          convex_ = false;
+          break;
+        }
+      }
+    }
+  }
 }
 
 void Boundary::at(unsigned triangle, double b1, double b2, Vec3d& x, Vec3d& n) const {

@@ -27,6 +27,7 @@ double inside_length(const Boundary& boundary, const Vec3d& x, const Vec3d& w,
       return inside;
     }
     if (in) inside += hit->t;
+    if (in && boundary.convex()) return inside;  // out, and never back in
     travelled += hit->t;
     in = w.dot(hit->ng) < 0;  // crossed inward: inside from here
     o = boundary.offset(*hit, w);

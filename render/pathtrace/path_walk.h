@@ -60,12 +60,16 @@ class Boundary {
     return p.x + (direction.dot(p.ng) > 0 ? epsilon_ : -epsilon_) * p.ng;
   }
   double epsilon() const { return epsilon_; }
+  /// Every vertex on the inner side of every face's plane: a ray leaving never comes back in
+  /// (checked for meshes up to 5e7 face-vertex pairs; larger ones are taken as not convex).
+  bool convex() const { return convex_; }
 
  private:
   const Mesh& mesh_;
   detail::RayScene rays_;
   double epsilon_;
   bool flip_;  ///< the mesh's winding points its face normals inward
+  bool convex_ = false;
 };
 
 /// Henyey-Greenstein: density per sr of turning by cos_theta, and a sampled new direction.
