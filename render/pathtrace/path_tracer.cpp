@@ -42,6 +42,37 @@ struct CameraRays {
   int W, H;
 };
 
+// The statistics of a finished render (--stats): counts, the object's mean and noise.
+void fill_stats(PathTraceImage& result, const pathtrace::WalkCounts& counts, double n,
+                std::size_t object, double eta, bool matched, std::size_t paths_per_sample,
+                double total_ms, double noise_sum, double value_sum) {
+  RenderStats& stats = result.stats;
+  stats.technique = "pathtrace";
+  stats.width = result.image.width;
+  stats.height = result.image.height;
+  stats.total_ms = total_ms;
+  stats.pass_ms = {{"paths", stats.total_ms}};
+  const double paths = double(std::max<std::uint64_t>(1, counts.paths));
+  stats.details = {{"samples_per_pixel", n},
+                   {"paths", counts.paths},
+                   {"collisions_per_path", double(counts.collisions) / paths},
+                   {"connections", counts.connections},
+                   {"connection_failures", counts.connection_failures},
+                   {"truncated_paths", counts.truncated},
+                   {"leaked_paths", counts.leaks},
+                   {"object_pixels", object},
+                   {"object_mean", result.object_mean},
+                   {"object_mean_standard_error", result.object_mean_error},
+                   // The RMS of the pixels' standard errors over the object, relative to its mean.
+                   {"relative_pixel_noise", object && value_sum > 0
+                                                ? std::sqrt(noise_sum / (3.0 * double(object))) /
+                                                      (value_sum / (3.0 * double(object)))
+                                                : 0.0},
+                   {"eta", eta},
+                   {"paths_per_sample", paths_per_sample},
+                   {"connection", matched ? "straight (eta = 1)" : "through one refraction"}};
+}
+
 }  // namespace
 
 void PathTraceOptions::validate() const {
@@ -154,31 +185,8 @@ PathTraceImage render_pathtrace(const Scene& scene, const PathTraceOptions& opti
     value_sum += sum[c];
   }
 
-  RenderStats& stats = result.stats;
-  stats.technique = "pathtrace";
-  stats.width = camera.width;
-  stats.height = camera.height;
-  stats.total_ms = detail::ms_since(start);
-  stats.pass_ms = {{"paths", stats.total_ms}};
-  const double paths = double(std::max<std::uint64_t>(1, counts.paths));
-  stats.details = {{"samples_per_pixel", n},
-                   {"paths", counts.paths},
-                   {"collisions_per_path", double(counts.collisions) / paths},
-                   {"connections", counts.connections},
-                   {"connection_failures", counts.connection_failures},
-                   {"truncated_paths", counts.truncated},
-                   {"leaked_paths", counts.leaks},
-                   {"object_pixels", object},
-                   {"object_mean", result.object_mean},
-                   {"object_mean_standard_error", result.object_mean_error},
-                   // The RMS of the pixels' standard errors over the object, relative to its mean.
-                   {"relative_pixel_noise", object && value_sum > 0
-                                                ? std::sqrt(noise_sum / (3.0 * double(object))) /
-                                                      (value_sum / (3.0 * double(object)))
-                                                : 0.0},
-                   {"eta", eta},
-                   {"paths_per_sample", groups.size()},
-                   {"connection", world.matched ? "straight (eta = 1)" : "through one refraction"}};
+  fill_stats(result, counts, n, object, eta, world.matched, groups.size(), detail::ms_since(start),
+             noise_sum, value_sum);
   return result;
 }
 

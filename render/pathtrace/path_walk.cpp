@@ -261,148 +261,179 @@ std::vector<Rgb> channel_groups(const MediumRgb& medium) {
   return groups;
 }
 
-Rgb trace_path(const World& w, const Vec3d& eye, const Vec3d& direction, const Rgb& carried,
-               Random& random, WalkCounts& counts) {
-  const MediumRgb& m = w.medium;
-  const Boundary& boundary = w.boundary;
-  ++counts.paths;
-  Rgb radiance = Rgb::Zero(), beta = carried;
-  Vec3d o = eye, d = direction;
+namespace {
+
+// A path's state between its stages.
+struct PathState {
+  Rgb radiance = Rgb::Zero(), beta;
+  Vec3d o, d;
   bool inside = false;
   bool first_surface = true;  // the camera ray has not met the boundary yet
   bool scattered = false;     // a collision happened
   int chain = 0;              // boundary events since the last collision
   double phase_pdf = 0;       // density of d at the last collision (per sr, the mixture's)
-  Vec3d last = eye;           // the last collision
+  Vec3d last;                 // the last collision
   int collisions = 0;
   // Inside, a ray starts a little off the surface point it left (so as not to hit its own face
   // again), `head` mm along itself: free paths are measured from the surface point, so the thin
   // layer skipped by the offset still holds collisions (an optical depth of 1e-3 at sigma_t = 1
   // mm^-1 in a 100 mm object otherwise lost: 0.6% of Chandrasekhar's reflection at sigma_t = 10).
   double head = 0;
-  const auto step_in = [&](const SurfacePoint& p, const Vec3d& dir, double& along) {
-    along = boundary.epsilon() / std::max(std::abs(dir.dot(p.ng)), 0.01);
-    return Vec3d(p.x + along * dir);
-  };
-  const auto sky = [&](const Vec3d& dir) {
-    return Rgb(w.lights.background(dir, 0), w.lights.background(dir, 1),
-               w.lights.background(dir, 2));
-  };
 
+  void step_in(const Boundary& boundary, const SurfacePoint& p) {
+    head = boundary.epsilon() / std::max(std::abs(d.dot(p.ng)), 0.01);
+    o = p.x + head * d;
+  }
+};
+
+Rgb sky(const World& w, const Vec3d& dir) {
+  return Rgb(w.lights.background(dir, 0), w.lights.background(dir, 1), w.lights.background(dir, 2));
+}
+
+// Outside: area emitters on the way (they do not block: the camera does not see them directly).
+void add_area_emitters(const World& w, PathState& p, const std::optional<SurfacePoint>& hit) {
+  double t_light = 0;
+  const int a = hit_area_emitter(w.lights, p.o, p.d, hit ? hit->t : 1e300, t_light);
+  if (a < 0 || !(p.scattered || p.chain > 0)) return;
+  const AreaEmitter& e = w.lights.area[std::size_t(a)];
+  double weight = 1;
+  if (p.scattered && w.matched) {  // straight from the last collision: MIS with its NEE
+    const Vec3d y = p.o + t_light * p.d;
+    const double distance = (y - p.last).norm();
+    const double p_light = distance * distance / (-p.d.dot(e.normal) * e.area);
+    weight = balance(p.phase_pdf, p_light);
+  } else if (p.scattered && p.chain == 1) {
+    weight = 0;  // collision, refraction out, light: the refracted connection's path
+  }
+  p.radiance += p.beta * weight * e.radiance.array();
+}
+
+// Outside, leaving the scene: what the camera sees behind, or the environment's light.
+void add_escape(const World& w, PathState& p) {
+  if (!p.scattered) {
+    p.radiance += p.beta * sky(w, p.d);
+  } else if (w.lights.environment) {
+    double weight = 1;
+    if (w.matched && w.lights.environment_sampler) {
+      weight = balance(p.phase_pdf, w.lights.environment_sampler->pdf(p.d.cast<float>()));
+    }
+    p.radiance += p.beta * weight * sky(w, p.d);
+  }
+}
+
+// Outside, at the boundary: Fresnel reflection or refraction in. False when the path ends.
+bool enter(const World& w, PathState& p, const SurfacePoint& hit, Random& random) {
+  Vec3d n = hit.n;
+  if (!(-p.d.dot(n) > 0)) n = hit.ng;  // the interpolated normal faces away: the face's
+  const double R = materials::fresnel_reflectance(-p.d.dot(n), w.eta);
+  Vec3d t;
+  const bool can_refract = refract(p.d, n, w.eta, t) && t.dot(hit.ng) < 0;
+  ++p.chain;
+  if (p.first_surface && !w.specular) {
+    p.beta *= 1 - R;  // the camera's own reflection removed
+  } else if (!can_refract || random.uniform() < R) {
+    p.d = reflect(p.d, n);
+    if (p.d.dot(hit.ng) < 0) p.d = reflect(p.d, hit.ng);  // grazing: keep it outside
+    p.first_surface = false;
+    p.o = w.boundary.offset(hit, p.d);
+    return true;
+  }
+  p.first_surface = false;
+  if (!can_refract) return false;
+  // Radiance scales by (n_outside / n_inside)^2 into the medium, and back on the way out: a path
+  // that leaves again carries 1; a next-event estimate inside (energy per area) 1 / eta^2.
+  p.beta /= w.eta * w.eta;
+  p.d = t;
+  p.inside = true;
+  p.step_in(w.boundary, hit);
+  return true;
+}
+
+// Inside, a collision at x: next-event estimates, roulette, a turn. False when the path ends.
+bool collide(const World& w, PathState& p, const Vec3d& x, Random& random, WalkCounts& counts) {
+  const MediumRgb& m = w.medium;
+  if (++p.collisions > w.options.max_collisions) {
+    ++counts.truncated;
+    return false;
+  }
+  ++counts.collisions;
+  p.scattered = true;
+  p.chain = 0;
+  p.last = x;
+  const Rgb share = shares_of(p.beta);
+  p.radiance += p.beta * next_event(w, x, -p.d, random, counts, &share);
+  const double top = p.beta.maxCoeff();
+  if (top < kRouletteBelow) {
+    if (random.uniform() * kRouletteBelow >= top) return false;
+    p.beta *= kRouletteBelow / top;
+  }
+  // The turn: from the one phase, or from a channel's picked by its share (the mixture's density
+  // divides each channel's own).
+  const int k = m.one_phase ? 0 : pick_channel(share, random.uniform());
+  const Vec3d turned = m.phase[std::size_t(k)].sample(p.d, random.uniform(), random.uniform());
+  const double cos_turn = turned.dot(p.d);
+  p.phase_pdf = mixture_phase_pdf(m, share, cos_turn);
+  if (!m.one_phase) p.beta *= m.phase_pdf(cos_turn) / p.phase_pdf;
+  p.d = turned;
+  p.o = x;
+  p.head = 0;
+  return true;
+}
+
+// Inside, at the boundary: internal reflection (total beyond the critical angle) or out.
+void leave(const World& w, PathState& p, const SurfacePoint& hit, Random& random) {
+  ++p.chain;
+  Vec3d n = hit.n;
+  if (!(p.d.dot(n) > 0)) n = hit.ng;
+  const double R = materials::fresnel_reflectance(p.d.dot(n), 1 / w.eta);
+  Vec3d t;
+  const bool can_refract = refract(p.d, -n, 1 / w.eta, t) && t.dot(hit.ng) > 0;
+  if (!can_refract || random.uniform() < R) {
+    p.d = reflect(p.d, n);
+    if (p.d.dot(hit.ng) > 0) p.d = reflect(p.d, hit.ng);
+    p.step_in(w.boundary, hit);
+    return;
+  }
+  p.beta *= w.eta * w.eta;
+  p.d = t;
+  p.inside = false;
+  p.o = w.boundary.offset(hit, p.d);
+}
+
+}  // namespace
+
+Rgb trace_path(const World& w, const Vec3d& eye, const Vec3d& direction, const Rgb& carried,
+               Random& random, WalkCounts& counts) {
+  ++counts.paths;
+  PathState p;
+  p.beta = carried;
+  p.o = p.last = eye;
+  p.d = direction;
   for (;;) {
-    const auto hit = boundary.hit(o, d);
-    if (!inside) {
-      // Area emitters on the way (they do not block: the camera does not see them directly).
-      double t_light = 0;
-      const int a = hit_area_emitter(w.lights, o, d, hit ? hit->t : 1e300, t_light);
-      if (a >= 0 && (scattered || chain > 0)) {
-        const AreaEmitter& e = w.lights.area[std::size_t(a)];
-        double weight = 1;
-        if (scattered && w.matched) {  // straight from the last collision: MIS with its NEE
-          const Vec3d y = o + t_light * d;
-          const double distance = (y - last).norm();
-          const double p_light = distance * distance / (-d.dot(e.normal) * e.area);
-          weight = balance(phase_pdf, p_light);
-        } else if (scattered && chain == 1) {
-          weight = 0;  // collision, refraction out, light: the refracted connection's path
-        }
-        radiance += beta * weight * e.radiance.array();
-      }
+    const auto hit = w.boundary.hit(p.o, p.d);
+    if (!p.inside) {
+      add_area_emitters(w, p, hit);
       if (!hit) {
-        if (!scattered) {
-          radiance += beta * sky(d);  // what the camera sees behind
-        } else if (w.lights.environment) {
-          double weight = 1;
-          if (w.matched && w.lights.environment_sampler) {
-            weight = balance(phase_pdf, w.lights.environment_sampler->pdf(d.cast<float>()));
-          }
-          radiance += beta * weight * sky(d);
-        }
-        return radiance;
+        add_escape(w, p);
+        return p.radiance;
       }
-      if (d.dot(hit->ng) > 0) {  // the inside of the mesh, seen from outside: an open mesh
+      if (p.d.dot(hit->ng) > 0) {  // the inside of the mesh, seen from outside: an open mesh
         ++counts.leaks;
-        return radiance;
+        return p.radiance;
       }
-      // Entering: Fresnel reflection or refraction.
-      Vec3d n = hit->n;
-      if (!(-d.dot(n) > 0)) n = hit->ng;  // the interpolated normal faces away: the face's
-      const double R = materials::fresnel_reflectance(-d.dot(n), w.eta);
-      Vec3d t;
-      const bool can_refract = refract(d, n, w.eta, t) && t.dot(hit->ng) < 0;
-      ++chain;
-      if (first_surface && !w.specular) {
-        beta *= 1 - R;  // the camera's own reflection removed
-      } else if (!can_refract || random.uniform() < R) {
-        d = reflect(d, n);
-        if (d.dot(hit->ng) < 0) d = reflect(d, hit->ng);  // grazing: keep it outside
-        first_surface = false;
-        o = boundary.offset(*hit, d);
-        continue;
-      }
-      first_surface = false;
-      if (!can_refract) return radiance;
-      // Radiance scales by (n_outside / n_inside)^2 into the medium, and back on the way out: a
-      // path that leaves again carries 1; a next-event estimate inside (energy per area) 1 / eta^2.
-      beta /= w.eta * w.eta;
-      d = t;
-      inside = true;
-      o = step_in(*hit, d, head);
+      if (!enter(w, p, *hit, random)) return p.radiance;
       continue;
     }
-
-    if (!hit || d.dot(hit->ng) < 0) {  // no way out, or a face seen from inside: a leak
+    if (!hit || p.d.dot(hit->ng) < 0) {  // no way out, or a face seen from inside: a leak
       ++counts.leaks;
-      return radiance;
+      return p.radiance;
     }
     double s = 0;
-    if (free_path(m, shares_of(beta), head + hit->t, random, beta, s)) {
-      // A collision: next-event estimates, roulette, a turn.
-      const Vec3d x = o + (s - head) * d;
-      if (++collisions > w.options.max_collisions) {
-        ++counts.truncated;
-        return radiance;
-      }
-      ++counts.collisions;
-      scattered = true;
-      chain = 0;
-      last = x;
-      const Rgb share = shares_of(beta);
-      radiance += beta * next_event(w, x, -d, random, counts, &share);
-      const double top = beta.maxCoeff();
-      if (top < kRouletteBelow) {
-        if (random.uniform() * kRouletteBelow >= top) return radiance;
-        beta *= kRouletteBelow / top;
-      }
-      // The turn: from the one phase, or from a channel's picked by its share (the mixture's
-      // density divides each channel's own).
-      const int k = m.one_phase ? 0 : pick_channel(share, random.uniform());
-      const Vec3d turned = m.phase[std::size_t(k)].sample(d, random.uniform(), random.uniform());
-      const double cos_turn = turned.dot(d);
-      phase_pdf = mixture_phase_pdf(m, share, cos_turn);
-      if (!m.one_phase) beta *= m.phase_pdf(cos_turn) / phase_pdf;
-      d = turned;
-      o = x;
-      head = 0;
+    if (free_path(w.medium, shares_of(p.beta), p.head + hit->t, random, p.beta, s)) {
+      if (!collide(w, p, p.o + (s - p.head) * p.d, random, counts)) return p.radiance;
       continue;
     }
-    // The boundary from inside: internal reflection (total beyond the critical angle) or out.
-    ++chain;
-    Vec3d n = hit->n;
-    if (!(d.dot(n) > 0)) n = hit->ng;
-    const double R = materials::fresnel_reflectance(d.dot(n), 1 / w.eta);
-    Vec3d t;
-    const bool can_refract = refract(d, -n, 1 / w.eta, t) && t.dot(hit->ng) > 0;
-    if (!can_refract || random.uniform() < R) {
-      d = reflect(d, n);
-      if (d.dot(hit->ng) > 0) d = reflect(d, hit->ng);
-      o = step_in(*hit, d, head);
-      continue;
-    }
-    beta *= w.eta * w.eta;
-    d = t;
-    inside = false;
-    o = boundary.offset(*hit, d);
+    leave(w, p, *hit, random);
   }
 }
 
