@@ -45,6 +45,7 @@ void run_view(ViewArguments& args) {
   options.settings = flags.settings;
   options.model_follows_material = !model_given;
   options.reference = flags.reference;
+  options.pathtrace = flags.pathtrace;
   options.view = {setup.azimuth_deg, setup.elevation_deg, setup.distance_radii};
   options.object_size_mm = args.scene.object_size_mm;
   options.technique = args.scene.technique_id;
@@ -84,13 +85,16 @@ void register_view_command(CLI::App& app) {
       "the difference of the current technique (maps, or sh after its best scale) against the last "
       "CPU reference of the same view, Esc quits. The panel "
       "(scaled to the window) switches the material (library or file, reloaded when the file "
-      "changes), technique (maps, sh, hierarchical, fur on --mesh tile with L for the seed's rotating lobe light, reference) and model, edits the material (per channel mean free path and albedo, "
+      "changes), technique (maps, sh, hierarchical, fur on --mesh tile with L for the seed's "
+      "rotating lobe light, reference, pathtrace) and model, edits the material (per channel mean "
+      "free path and albedo, "
       "eta, g), and has sliders for N, M, q, K, W_s, W_l, T, exposure, object size and the "
       "deformer.");
   // The reference in the window runs pass after pass at half the window's resolution: fewer
   // samples per pass than `lucent render`'s default keep the first picture quick.
   args->scene.options.reference.surface_samples = 20000;
   args->scene.options.reference.pixel_samples = 64;
+  args->scene.options.pathtrace.pixel_samples = 4;
   args->scene.size = "960x720";
   add_scene_options(cmd, args->scene, "window size WxH in pixels");
   cmd->add_option("--deform", args->deform,

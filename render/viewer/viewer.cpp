@@ -61,13 +61,13 @@ Viewer::Viewer(const ViewerOptions& options)
   std::snprintf(material_path_.data(), material_path_.size(), "%s", material_source_.c_str());
   if (deform_amplitude_ != options.deform_amplitude) set_deform(options.deform_amplitude);
   rebuild_maps();
-  reference_ = std::make_unique<ReferenceWorker>();
-  if (technique_ == TechniqueId::kReference) scene_changed();
+  cpu_worker_ = std::make_unique<CpuWorker>();
+  if (on_cpu()) scene_changed();
   last_time_ = glfwGetTime();
 }
 
 Viewer::~Viewer() {
-  reference_.reset();
+  cpu_worker_.reset();
   if (reference_fbo_ != 0) glDeleteFramebuffers(1, &reference_fbo_);
   if (reference_texture_ != 0) glDeleteTextures(1, &reference_texture_);
   for (LiveTechnique& t : live_) t.technique.reset();
@@ -83,14 +83,12 @@ int Viewer::run() {
     // input, a finished reference pass (the worker needs the CPU more than the window does) and,
     // now and then, to watch the material file.
     const Technique* t = live(technique_);
-    const bool accumulating =
-        technique_ != TechniqueId::kReference && (t == nullptr || !t->converged() || deformer_ ||
-                                                  (technique_ == TechniqueId::kFur && fur_lobe_));
+    const bool accumulating = !on_cpu() && (t == nullptr || !t->converged() || deformer_ ||
+                                            (technique_ == TechniqueId::kFur && fur_lobe_));
     if (accumulating) {
       glfwPollEvents();
     } else {
-      glfwWaitEventsTimeout(
-          script_pos_ < script_.size() || technique_ == TechniqueId::kReference ? 0.05 : 0.25);
+      glfwWaitEventsTimeout(script_pos_ < script_.size() || on_cpu() ? 0.05 : 0.25);
     }
     frame();
   }
@@ -123,7 +121,7 @@ void Viewer::frame() {
   run_script_step();
   handle_keys();
   handle_mouse();
-  if (deformer_ && technique_ != TechniqueId::kReference) {
+  if (deformer_ && !on_cpu()) {
     deformer_->apply(now, scene_.mesh);
     apply_geometry();
     ++restarts_;
@@ -139,7 +137,7 @@ void Viewer::frame() {
 
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   if (width_ > 0 && height_ > 0) {
-    if (technique_ == TechniqueId::kReference) {
+    if (on_cpu()) {
       draw_reference();
     } else {
       draw_technique();
@@ -163,8 +161,7 @@ void Viewer::run_script_step() {
   if (now < sleep_until_) return;
   if (settling_) {
     const Technique* t = live(technique_);
-    const bool done = technique_ == TechniqueId::kReference ? reference_passes_ > 0
-                                                            : t != nullptr && t->converged();
+    const bool done = on_cpu() ? reference_passes_ > 0 : t != nullptr && t->converged();
     if (!done && now < settle_deadline_) return;
     if (!done) std::fprintf(stderr, "view: settle: still not done after %g s\n", kSettleTimeout);
     settling_ = false;
@@ -264,7 +261,7 @@ void Viewer::view_changed() {
   ++scene_version_;  // the cached reference was of the old view
   scene_.camera = view_.camera(scene_.mesh, std::max(width_, 1), std::max(height_, 1));
   ++versions_.camera;
-  if (technique_ == TechniqueId::kReference) scene_changed();
+  if (on_cpu()) scene_changed();
 }
 
 void Viewer::scene_changed() {
@@ -272,15 +269,15 @@ void Viewer::scene_changed() {
   ++scene_version_;
   for (LiveTechnique& t : live_)
     if (t.technique) t.technique->restart();
-  if (technique_ == TechniqueId::kReference) {
+  if (on_cpu()) {
     // Half the window's resolution in each direction: four times fewer pixels to integrate.
     Scene small = scene_;
     small.camera.width = std::max(1, width_ / 2);
     small.camera.height = std::max(1, height_ / 2);
-    reference_->start(small, settings_.model, options_.reference);
+    cpu_worker_->start(small, technique_, settings_.model, technique_options());
     reference_passes_ = 0;
-  } else if (reference_) {
-    reference_->pause();
+  } else if (cpu_worker_) {
+    cpu_worker_->pause();
   }
 }
 

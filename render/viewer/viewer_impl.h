@@ -45,13 +45,13 @@
 namespace lucent::render::viewer_detail {
 
 // ---------------------------------------------------------------------------------------------
-// The CPU reference on a worker thread: one pass after another (new samples each), summed until the
-// scene changes; the main thread shows the running mean.
+// A CPU technique (the reference, the path tracer) on a worker thread: one pass after another (new
+// samples each), summed until the scene changes; the main thread shows the running mean.
 
-class ReferenceWorker {
+class CpuWorker {
  public:
-  ReferenceWorker() : thread_([this] { loop(); }) {}
-  ~ReferenceWorker() {
+  CpuWorker() : thread_([this] { loop(); }) {}
+  ~CpuWorker() {
     {
       std::lock_guard lock(mutex_);
       quit_ = true;
@@ -61,10 +61,11 @@ class ReferenceWorker {
   }
 
   /// Starts over on `scene` (what the worker is doing now is thrown away when it finishes).
-  void start(const Scene& scene, DiffusionModel model, const ReferenceOptions& options) {
+  void start(const Scene& scene, TechniqueId id, DiffusionModel model,
+             const TechniqueOptions& options) {
     {
       std::lock_guard lock(mutex_);
-      job_ = Job{scene, model, options, ++generation_};
+      job_ = Job{scene, id, model, options, ++generation_};
       sum_ = ImageRgb();
       passes_ = 0;
       error_.clear();
@@ -93,10 +94,28 @@ class ReferenceWorker {
  private:
   struct Job {
     Scene scene;
+    TechniqueId id;
     DiffusionModel model;
-    ReferenceOptions options;
+    TechniqueOptions options;
     std::uint64_t generation;
   };
+
+  // One pass of the job's technique with its own seed.
+  static ImageRgb render_pass(const Job& job, int pass) {
+    const std::uint64_t seed = job.options.reference.seed + std::uint64_t(pass) * 7919;
+    if (job.id == TechniqueId::kPathtrace) {
+      PathTraceOptions options = job.options.pathtrace;
+      options.passes = 1;
+      options.seed = seed;
+      options.progress = nullptr;
+      return render_pathtrace(job.scene, options).image;
+    }
+    ReferenceOptions options = job.options.reference;
+    options.passes = 1;
+    options.seed = seed;
+    options.progress = nullptr;
+    return render_reference(job.scene, job.model, options).image;
+  }
 
   void loop() {
     for (;;) {
@@ -109,14 +128,10 @@ class ReferenceWorker {
         job = *job_;
         pass = passes_;
       }
-      ReferenceOptions options = job.options;
-      options.passes = 1;
-      options.seed = job.options.seed + std::uint64_t(pass) * 7919;
-      options.progress = nullptr;
       std::optional<ImageRgb> image;
       std::string error;
       try {
-        image = render_reference(job.scene, job.model, options).image;
+        image = render_pass(job, pass);
       } catch (const std::exception& e) {
         error = e.what();
       }
@@ -199,6 +214,9 @@ class Viewer {
   void draw_scene_controls();  // exposure, object size, deformer, lights
   void draw_progress();        // statistics, the difference view
   void draw_reference();
+  /// The current technique renders on the CPU, pass after pass on the worker (reference,
+  /// pathtrace).
+  bool on_cpu() const { return !technique_info(technique_).gpu; }
   // One frame of the current frame-by-frame technique (made and brought up to date first), on
   // screen or in the difference view; one that fails says why and hands over to the maps.
   void draw_technique();
@@ -241,11 +259,11 @@ class Viewer {
   bool model_from_material_ = true;
   OrbitView view_;
   TechniqueId technique_ = TechniqueId::kMaps;
-  // By TechniqueId; the reference's slot stays empty (it runs on reference_, a worker thread).
+  // By TechniqueId; the CPU techniques' slots stay empty (they run on cpu_worker_, a thread).
   std::array<LiveTechnique, 6> live_;
   SceneVersions versions_;
   bool fur_lobe_ = false;  // the seed's rotating lobe light instead of the scene's lights
-  std::unique_ptr<ReferenceWorker> reference_;
+  std::unique_ptr<CpuWorker> cpu_worker_;  // the reference or the path tracer
   FileWatcher watcher_;
   double last_watch_ = 0;
   std::string material_source_;
@@ -271,6 +289,7 @@ class Viewer {
   // The reference's latest mean, valid for the scene and view of scene_version_ == its version:
   // what the difference view compares the maps against.
   ImageRgb cached_reference_;
+  std::string cached_label_ = "reference";  // the technique that made it (reference, pathtrace)
   std::uint64_t scene_version_ = 0, reference_version_ = ~std::uint64_t(0);
   bool show_difference_ = false;
   std::string difference_text_;

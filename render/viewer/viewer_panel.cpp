@@ -59,7 +59,6 @@ void Viewer::draw_choices() {
   bool first = true;
   for (const TechniqueInfo& t : techniques()) {
     if (t.id == TechniqueId::kFur && scene_.mesh.name != "tile") continue;
-    if (t.id == TechniqueId::kPathtrace) continue;  // not in the viewer yet (issue 35, part 4)
     if (!first) ImGui::SameLine();
     first = false;
     if (ImGui::RadioButton(t.panel_label.c_str(), &technique, int(t.id))) set_technique(t.id);
@@ -151,8 +150,7 @@ void Viewer::draw_scene_controls() {
     ImGui::SameLine();
     if (ImGui::Button("larger ]")) scale_selected_light(1.25f);
   }
-  if (technique_ == TechniqueId::kReference && deformer_)
-    ImGui::TextUnformatted("(the deformer pauses for the reference)");
+  if (on_cpu() && deformer_) ImGui::TextUnformatted("(the deformer pauses for the reference)");
   }
 }
 
@@ -176,12 +174,18 @@ void Viewer::draw_progress() {
     if (!info.physically_based)
       ImGui::TextDisabled("not physically based: D compares it after a best scale");
   } else {
-    ImGui::Text("reference passes %d (%d probes per pixel each)", reference_passes_,
-                options_.reference.pixel_samples);
+    if (technique_ == TechniqueId::kPathtrace) {
+      ImGui::Text("path tracer passes %d (%d paths per pixel each)", reference_passes_,
+                  options_.pathtrace.pixel_samples);
+    } else {
+      ImGui::Text("reference passes %d (%d probes per pixel each)", reference_passes_,
+                  options_.reference.pixel_samples);
+    }
     if (!reference_error_.empty()) ImGui::TextWrapped("%s", reference_error_.c_str());
   }
-  if (technique_ != TechniqueId::kReference) {
-    ImGui::Checkbox("difference vs reference (D)", &show_difference_);
+  if (!on_cpu()) {
+    const std::string label = "difference vs " + cached_label_ + " (D)";
+    ImGui::Checkbox(label.c_str(), &show_difference_);
     if (show_difference_) ImGui::TextWrapped("%s", difference_text_.c_str());
   }
 }

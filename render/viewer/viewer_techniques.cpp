@@ -25,6 +25,8 @@ TechniqueOptions Viewer::technique_options() const {
   o.hierarchical = options_.hierarchical;
   o.fur = options_.fur;
   o.reference = options_.reference;
+  o.pathtrace = options_.pathtrace;
+  o.pathtrace.seed = options_.reference.seed;
   return o;
 }
 
@@ -105,8 +107,9 @@ ImageRgb Viewer::technique_image() const {
 void Viewer::draw_reference() {
   ImageRgb mean;
   int passes = 0;
-  if (reference_->take(mean, passes, reference_error_)) {
+  if (cpu_worker_->take(mean, passes, reference_error_)) {
     cached_reference_ = mean;
+    cached_label_ = technique_info(technique_).name;
     reference_version_ = scene_version_;
     if (auto_exposure_) {
       settings_.exposure = pending_.exposure = auto_exposure(mean);
@@ -126,7 +129,7 @@ void Viewer::draw_difference() {
   glClear(GL_COLOR_BUFFER_BIT);
   if (reference_version_ != scene_version_ || cached_reference_.data.empty()) {
     difference_text_ =
-        "no reference for this view: switch to the CPU reference, let it run a "
+        "no CPU image of this view: switch to the reference or the path tracer, let it run a "
         "pass, come back";
     const Technique* t = live(technique_);
     (t != nullptr ? t : live(TechniqueId::kMaps))->present(settings_.exposure, width_, height_);
@@ -163,8 +166,8 @@ void Viewer::draw_difference() {
           info.frame_snapshots
               ? " (frame " + std::to_string(live(technique_)->frame_stats().frames) + ")"
               : "";
-      std::printf("view: %s%s against the reference (%d passes): %s\n", info.name.c_str(),
-                  frame.c_str(), reference_passes_, difference_text_.c_str());
+      std::printf("view: %s%s against the %s (%d passes): %s\n", info.name.c_str(), frame.c_str(),
+                  cached_label_.c_str(), reference_passes_, difference_text_.c_str());
       std::fflush(stdout);
       difference_frame_ = frames_drawn_;
     }

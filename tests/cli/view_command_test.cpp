@@ -226,6 +226,28 @@ TEST_F(ViewCommand, ShowsTheHierarchicalTechniqueAgainstTheReference) {
   EXPECT_LT(std::stod(r.out.substr(rmse + 14)), 0.3) << r.out.substr(at, 200);
 }
 
+// The path tracer in the window (pass after pass on the worker) and the maps' difference view
+// against it: the truth of the same view, without a scale.
+TEST_F(ViewCommand, ShowsThePathTracerAndTheMapsAgainstIt) {
+  const CommandResult r = view(
+      "--material skin1 --light directional:1,0.2,0:3,3,3 --technique pathtrace "
+      "--pathtrace-samples-pixel 2" +
+      kTiny +
+      " --script 'settle; screenshot a.png; set technique maps; difference on; wait 31; "
+      "quit'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_TRUE(fs::exists(dir_ / "a.png")) << r.out << r.err;
+  EXPECT_GT(load_shot(dir_ / "a.png").lit, 100);
+  const std::size_t at = r.out.find("against the pathtrace");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  const std::size_t ratio = r.out.find("mean ratio R ", at);
+  ASSERT_NE(ratio, std::string::npos) << r.out;
+  // The maps miss single scattering and more: below the truth, but the same object.
+  const double red = std::stod(r.out.substr(ratio + 13));
+  EXPECT_GT(red, 0.3) << r.out.substr(at, 200);
+  EXPECT_LT(red, 1.2) << r.out.substr(at, 200);
+}
+
 TEST_F(ViewCommand, BadInputFailsWithOneLine) {
   CommandResult r = view("--material no_such_material --light directional:0,0,1:1,1,1");
   EXPECT_NE(r.exit_code, 0);

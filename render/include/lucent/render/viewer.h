@@ -31,6 +31,7 @@ struct ViewerOptions {
   RenderSettings settings;         ///< the radiance-map knobs and the model
   bool model_follows_material = true;  ///< no --model: a newly chosen material brings its model
   ReferenceOptions reference;      ///< surface samples per pass, threads and seed for the reference
+  PathTraceOptions pathtrace;      ///< paths per pixel per pass for the path tracer
   OrbitView view;                  ///< --view
   double object_size_mm = 100;     ///< the mesh's bounding-box diagonal as loaded
   TechniqueId technique = TechniqueId::kMaps;
