@@ -100,9 +100,10 @@ Vec3d Phase::sample(const Vec3d& direction, double xi1, double xi2) const {
       .normalized();
 }
 
-double Lights::background(const Vec3d& direction, int c) const {
-  if (environment) return environment_lookup(*environment, direction.cast<float>())[c];
-  return backdrop[c];
+Rgb Lights::background(const Vec3d& direction) const {
+  if (environment)
+    return environment_lookup(*environment, direction.cast<float>()).cast<double>().array();
+  return backdrop.array();
 }
 
 Lights gather_lights(const Scene& scene) {

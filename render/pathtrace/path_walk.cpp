@@ -110,7 +110,7 @@ Rgb next_event(const World& w, const Vec3d& x, const Vec3d& toward, Random& rand
     }
     Connection link;
     const Link outcome = refracted_connection(w, light, x, link);
-    counts.count(int(outcome));
+    counts.count(outcome);
     if (outcome == Link::kConnected) {
       sum += value * m.phase_pdf(link.travel.dot(toward)) * link.irradiance *
              (-m.sigma_t * link.distance).exp();
@@ -138,7 +138,7 @@ Rgb next_event(const World& w, const Vec3d& x, const Vec3d& toward, Random& rand
     point.position = y.cast<float>();
     Connection link;
     const Link outcome = refracted_connection(w, point, x, link);
-    counts.count(int(outcome));
+    counts.count(outcome);
     if (outcome == Link::kConnected) {
       const double cos_light = (link.exit - y).normalized().dot(e.normal);
       if (cos_light > 0) {
@@ -154,8 +154,7 @@ Rgb next_event(const World& w, const Vec3d& x, const Vec3d& toward, Random& rand
     if (pdf > 0) {
       const double length =
           inside_length(w.boundary, x, dir, std::numeric_limits<double>::infinity());
-      const Rgb sky(w.lights.background(dir, 0), w.lights.background(dir, 1),
-                    w.lights.background(dir, 2));
+      const Rgb sky = w.lights.background(dir);
       sum += sky * m.phase_pdf(-dir.dot(toward)) * (-m.sigma_t * length).exp() / pdf *
              weight(pdf, dir);
     }
@@ -286,10 +285,6 @@ struct PathState {
   }
 };
 
-Rgb sky(const World& w, const Vec3d& dir) {
-  return Rgb(w.lights.background(dir, 0), w.lights.background(dir, 1), w.lights.background(dir, 2));
-}
-
 // Outside: area emitters on the way (they do not block: the camera does not see them directly).
 void add_area_emitters(const World& w, PathState& p, const std::optional<SurfacePoint>& hit) {
   double t_light = 0;
@@ -311,13 +306,13 @@ void add_area_emitters(const World& w, PathState& p, const std::optional<Surface
 // Outside, leaving the scene: what the camera sees behind, or the environment's light.
 void add_escape(const World& w, PathState& p) {
   if (!p.scattered) {
-    p.radiance += p.beta * sky(w, p.d);
+    p.radiance += p.beta * w.lights.background(p.d);
   } else if (w.lights.environment) {
     double weight = 1;
     if (w.matched && w.lights.environment_sampler) {
       weight = balance(p.phase_pdf, w.lights.environment_sampler->pdf(p.d.cast<float>()));
     }
-    p.radiance += p.beta * weight * sky(w, p.d);
+    p.radiance += p.beta * weight * w.lights.background(p.d);
   }
 }
 

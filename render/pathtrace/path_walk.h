@@ -118,8 +118,8 @@ struct Lights {
   std::unique_ptr<EnvironmentSampler> environment_sampler;
   Vec3d backdrop = Vec3d::Zero();
 
-  /// The radiance a ray leaving the scene in `direction` sees (environment or backdrop), channel c.
-  double background(const Vec3d& direction, int c) const;
+  /// The radiance a ray leaving the scene in `direction` sees (environment or backdrop).
+  Rgb background(const Vec3d& direction) const;
 };
 Lights gather_lights(const Scene& scene);
 
@@ -127,18 +127,21 @@ Lights gather_lights(const Scene& scene);
 int hit_area_emitter(const Lights& lights, const Vec3d& origin, const Vec3d& direction,
                      double t_max, double& t);
 
+/// How a refracted connection ended (refracted_connection): kNone where no such path exists (the
+/// light behind the surface, something in the way), kFailed where the iteration did not converge.
+enum class Link { kConnected, kNone, kFailed };
+
 /// Counts gathered per worker and summed.
 struct WalkCounts {
   std::uint64_t paths = 0, collisions = 0, connections = 0, connection_failures = 0, truncated = 0,
-                leaks = 0, roulette_skips = 0;
-  void count(int outcome) {  // a Link
-    if (outcome == 0) ++connections;
-    if (outcome == 2) ++connection_failures;
+                leaks = 0;
+  void count(Link outcome) {
+    if (outcome == Link::kConnected) ++connections;
+    if (outcome == Link::kFailed) ++connection_failures;
   }
   void add(const WalkCounts& o) {
     paths += o.paths, collisions += o.collisions, connections += o.connections;
     connection_failures += o.connection_failures, truncated += o.truncated, leaks += o.leaks;
-    roulette_skips += o.roulette_skips;
   }
 };
 
@@ -199,7 +202,6 @@ struct Connection {
   double distance = 0;    ///< mm
   Vec3d exit;             ///< y, where the light crosses the boundary, mm
 };
-enum class Link { kConnected, kNone, kFailed };  ///< kNone: no such path (behind, blocked)
 Link refracted_connection(const World& world, const Light& light, const Vec3d& x, Connection& out);
 
 /// Refraction of travel direction d at a surface of normal n (facing the side d comes from,
