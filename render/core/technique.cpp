@@ -30,7 +30,7 @@ const std::vector<TechniqueInfo>& techniques() {
   static const std::vector<TechniqueInfo> table = {
       {TechniqueId::kMaps, "maps", "radiance maps", "radiance maps",
        "maps (real-time radiance maps, OpenGL)", true, all, "", true, true, true,
-       &make<RadianceMapRenderer>},
+       &make<RadianceMapRenderer>, true},
       {TechniqueId::kSh, "sh", "SH fast translucency", "SH fast",
        "sh (spherical-harmonics fast translucency, OpenGL, Banterle & Chalmers: not physically "
        "based)",
@@ -47,7 +47,8 @@ const std::vector<TechniqueInfo>& techniques() {
        true,
        true,
        false,
-       &make<HierarchicalRenderer>},
+       &make<HierarchicalRenderer>,
+       true},
       {TechniqueId::kFur, "fur", "fur shells with SH transfer", "fur",
        "fur (Klotzli & Olano: shells with SH transfer; --mesh tile is the seed's tile, other "
        "meshes get a "

@@ -81,14 +81,15 @@ std::vector<BadCase> option_cases() {
       {"render_passes_zero", nullptr, ren + "--reference-passes 0", "--reference-passes"},
       {"render_single_scattering_foo", nullptr, ren + "--single-scattering foo",
        "--single-scattering"},
-      {"render_single_scattering_maps", nullptr,
-       ren.substr(0, ren.find("--technique")) + "--technique maps --single-scattering on " +
+      {"render_single_scattering_sh", nullptr,
+       ren.substr(0, ren.find("--technique")) + "--technique sh --single-scattering on " +
            ren.substr(ren.find("--technique") + 22),
        "--single-scattering"},
       {"render_pathtrace_samples_zero", nullptr, ren + "--pathtrace-samples-pixel 0",
        "--pathtrace-samples-pixel"},
       {"render_pathtrace_passes_zero", nullptr, ren + "--pathtrace-passes 0", "--pathtrace-passes"},
-      {"render_pathtrace_jitter_foo", nullptr, ren + "--pathtrace-jitter foo", "--pathtrace-jitter"},
+      {"render_pathtrace_jitter_foo", nullptr, ren + "--pathtrace-jitter foo",
+       "--pathtrace-jitter"},
       {"render_stats_folder_missing", nullptr, ren + "--stats {dir}/nodir/s.json", "nodir"},
       {"render_output_folder_missing", nullptr,
        ren.substr(0, ren.find("-o ")) + "-o {dir}/nodir/r.exr", "nodir"},

@@ -34,6 +34,9 @@ foreach(t glsl_twin_test radiance_maps_test sh_renderer_test area_light_test fur
           fur_renderer_test)
   target_include_directories(${t} PRIVATE ${LUCENT_RENDER_PRIVATE_DIRS})
 endforeach()
+lucent_add_test(single_scattering_gl_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/single_scattering_gl_test.cpp
+  LIBS lucent::render lucent::materials OpenGL::OpenGL)
 lucent_add_test(hierarchical_renderer_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/hierarchical_renderer_test.cpp
   LIBS lucent::render lucent::materials OpenGL::OpenGL)

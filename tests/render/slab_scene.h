@@ -94,6 +94,29 @@ inline double centre_truth(const SlabScene& s, materials::DiffusionModel model, 
   return materials::fresnel_transmittance(1.0, m.ior) * s.irradiance * integral / std::numbers::pi;
 }
 
+/// The single scattering leaving the plane boundary of a semi-infinite medium (y < 0, channel c)
+/// lit by a sun of irradiance 1 from the unit w_i and seen from the unit w_o (both y > 0): the
+/// integral along the refracted view ray of the refracted collimated beam (Hanrahan and Krueger
+/// 1993's first order),
+///   L = F_t(cos_i) F_t(cos_o) cos_i sigma_s p_g(d_in . d_out) / (eta^2 sigma_t (cos_ti + cos_to)),
+/// d_in the light's refracted travel direction, d_out the refracted view ray's reverse.
+inline double single_scattering_truth(const materials::Material& material, int c,
+                                      const Eigen::Vector3d& w_i, const Eigen::Vector3d& w_o) {
+  const materials::Medium<double> m = material.medium(c);
+  const double eta = material.ior;
+  const auto inside = [&](const Eigen::Vector3d& w) {  // the refracted travel direction from w
+    const double cos_t = std::sqrt(1 - (1 - w.y() * w.y()) / (eta * eta));
+    return Eigen::Vector3d(-w.x() / eta, -cos_t, -w.z() / eta);
+  };
+  const Eigen::Vector3d d_in = inside(w_i), d_out = -inside(w_o);
+  const double cos_theta = d_in.dot(d_out), g = m.g;
+  const double d = 1 + g * g - 2 * g * cos_theta;
+  const double phase = (1 - g * g) / (4 * std::numbers::pi * d * std::sqrt(d));
+  return materials::fresnel_transmittance(w_i.y(), eta) *
+         materials::fresnel_transmittance(w_o.y(), eta) * w_i.y() * m.sigma_s * phase /
+         (eta * eta * (m.sigma_a + m.sigma_s) * (-d_in.y() + d_out.y()));
+}
+
 /// Mean of channel c over the image (all of it sees the face).
 inline double centre_mean(const ImageRgb& image, int c) {
   double sum = 0;

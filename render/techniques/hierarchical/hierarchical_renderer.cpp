@@ -4,12 +4,14 @@
 #include "lucent/render/technique.h"
 
 #include <chrono>
+#include <thread>
 
 #include "gl_api.h"
 #include "gl_area_lights.h"
 #include "gl_bssrdf.h"
 #include "gl_frame.h"
 #include "gl_program.h"
+#include "hierarchical_single.h"
 #include "lucent/core/error.h"
 #include "lucent/render/gl_context.h"
 #include "radiance_maps_sampling.h"
@@ -32,6 +34,11 @@ struct HierarchicalRenderer::Impl {
   std::unique_ptr<hierarchical::Solver> solver;
   gl::MeshBuffers mesh;
   gl::Buffer B;
+  gl::Buffer single;  // the single scattering per vertex toward the eye (zeros when off)
+  std::unique_ptr<detail::RayScene> rays;  // for the single scattering; made on first use
+  bool single_valid = false;               // for single_eye and the scene's lights and material
+  Vec3f single_eye = Vec3f::Zero();
+  double single_ms = 0;
   gl::Program program;
   gl::FinalTarget final;  // the image, its environment, background and present pass
   int width = 0, height = 0;
@@ -44,6 +51,22 @@ struct HierarchicalRenderer::Impl {
   void fit_bounds() {
     centre = scene.mesh.centre();
     radius = std::max(scene.mesh.bounding_radius(), 1e-6f);
+  }
+
+  // The single-scattering stream for the camera's eye, recomputed when the eye, lights, material or
+  // geometry changed.
+  void update_single() {
+    if (!scene.single_scattering) return;
+    if (single_valid && single_eye == scene.camera.eye) return;
+    const double t0 = now_ms();
+    if (!rays) rays = std::make_unique<detail::RayScene>(scene.mesh);
+    const int threads = int(std::max(1u, std::thread::hardware_concurrency()));
+    const std::vector<float> values = hierarchical::vertex_single_scattering(
+        *rays, scene.mesh, scene.material, scene.lights, scene.camera.eye, threads);
+    glNamedBufferSubData(single.id(), 0, GLsizeiptr(values.size() * sizeof(float)), values.data());
+    single_eye = scene.camera.eye;
+    single_valid = true;
+    single_ms = now_ms() - t0;
   }
 
   void upload_lights() {
@@ -100,6 +123,14 @@ void HierarchicalRenderer::setup(const Scene& scene, const hierarchical::Options
   glEnableVertexArrayAttrib(vao, 2);
   glVertexArrayAttribFormat(vao, 2, 3, GL_FLOAT, GL_FALSE, 0);
   glVertexArrayAttribBinding(vao, 2, 2);
+  const std::vector<float> zeros(mesh.positions.size() * 3, 0.0f);
+  m.single = gl::create_buffer();
+  glNamedBufferStorage(m.single.id(), GLsizeiptr(zeros.size() * sizeof(float)), zeros.data(),
+                       GL_DYNAMIC_STORAGE_BIT);
+  glVertexArrayVertexBuffer(vao, 3, m.single.id(), 0, 3 * sizeof(float));
+  glEnableVertexArrayAttrib(vao, 3);
+  glVertexArrayAttribFormat(vao, 3, 3, GL_FLOAT, GL_FALSE, 0);
+  glVertexArrayAttribBinding(vao, 3, 3);
   // Area lights' branches always compiled here: hierarchical.frag is one cheap pass.
   std::vector<std::string> defines = {"LUCENT_MAX_LIGHTS " + std::to_string(kMaxLights),
                                       "LUCENT_AREA_LIGHTS"};
@@ -128,6 +159,7 @@ void HierarchicalRenderer::set_lights(const std::vector<Light>& lights) {
   m.scene.lights = lights;
   m.upload_lights();
   m.solver->set_lights(lights);
+  m.single_valid = false;
 }
 
 void HierarchicalRenderer::set_material(const materials::Material& material) {
@@ -139,6 +171,7 @@ void HierarchicalRenderer::set_material(const materials::Material& material) {
   }
   m.scene.material = material;
   m.solver->set_material(material);
+  m.single_valid = false;
   glProgramUniform1f(m.program.id(), m.program.location("u_eta"), float(material.ior));
 }
 
@@ -150,6 +183,8 @@ void HierarchicalRenderer::set_geometry(const std::vector<Vec3f>& positions,
   m.scene.mesh.positions = positions;
   m.scene.mesh.normals = normals;
   m.fit_bounds();
+  m.rays.reset();
+  m.single_valid = false;
 }
 
 void HierarchicalRenderer::setup(const Scene& scene, const TechniqueOptions& options) {
@@ -168,6 +203,7 @@ FrameStats HierarchicalRenderer::frame_stats() const {
   f.pass_ms = {{"link", s.link_ms},
                {"irradiance", s.irradiance_ms},
                {"gather+push", s.pull_ms + s.gather_ms + s.push_ms},
+               {"single scattering", m.single_ms},
                {"draw", m.draw_ms}};
   f.notes.push_back(std::to_string(s.triangles) + " triangles, " + std::to_string(s.links) +
                     " links");
@@ -177,6 +213,7 @@ FrameStats HierarchicalRenderer::frame_stats() const {
 bool HierarchicalRenderer::render_frame() {
   Impl& m = *impl_;
   m.solver->solve();
+  m.update_single();
   double t0 = now_ms();
   const auto& vb = m.solver->vertex_B();
   m.B_floats.resize(vb.size() * 3);
@@ -223,6 +260,9 @@ const hierarchical::Stats& HierarchicalRenderer::stats() const {
 }
 double HierarchicalRenderer::upload_ms() const { return impl_->upload_ms; }
 double HierarchicalRenderer::draw_ms() const { return impl_->draw_ms; }
+double HierarchicalRenderer::single_scattering_ms() const {
+  return impl_->single_ms;
+}
 const hierarchical::Solver& HierarchicalRenderer::solver() const {
   return *impl_->solver;
 }
@@ -241,10 +281,15 @@ ImageRgb render_hierarchical(const Scene& scene, const hierarchical::Options& op
     stats->width = scene.camera.width;
     stats->height = scene.camera.height;
     stats->total_ms = now_ms() - t0;
-    stats->pass_ms = {{"hierarchy", s.build_ms},       {"link", s.link_ms},
-                      {"irradiance", s.irradiance_ms}, {"pull", s.pull_ms},
-                      {"gather", s.gather_ms},         {"push", s.push_ms},
-                      {"upload", renderer.upload_ms()}, {"draw", renderer.draw_ms()}};
+    stats->pass_ms = {{"hierarchy", s.build_ms},
+                      {"link", s.link_ms},
+                      {"irradiance", s.irradiance_ms},
+                      {"pull", s.pull_ms},
+                      {"gather", s.gather_ms},
+                      {"push", s.push_ms},
+                      {"single scattering", renderer.single_scattering_ms()},
+                      {"upload", renderer.upload_ms()},
+                      {"draw", renderer.draw_ms()}};
     stats->details = {{"triangles", s.triangles},
                       {"clusters", s.clusters},
                       {"depth", s.depth},
@@ -252,6 +297,7 @@ ImageRgb render_hierarchical(const Scene& scene, const hierarchical::Options& op
                       {"form_factor_calls", s.form_factor_calls},
                       {"point_samples", s.point_samples},
                       {"edge_segments", s.edge_segments},
+                      {"single_scattering", scene.single_scattering},
                       {"timing", "one frame from scratch (hierarchy, links, solve), wall clock"},
                       {"options", options.to_string()}};
   }

@@ -181,6 +181,8 @@ void RadianceMapRenderer::Impl::build_programs() {
   unit(final_program, "u_radiance_depth", kUnitRadianceDepth);
   unit(final_program, "u_environment", kUnitEnvironment);
   unit(final_program, "u_light_positions", kUnitLightPositionsFinal);
+  unit(final_program, "u_light_normals", kUnitLightNormalsFinal);
+  unit(final_program, "u_light_face_normals", kUnitLightFaceNormalsFinal);
 
   // One sampler object per way of reading: filters and wrap modes.
   const auto sampler = [](GLint min_filter, GLint mag_filter, GLint wrap_s) {
@@ -382,8 +384,16 @@ void RadianceMapRenderer::Impl::upload_material() {
   if (settings.model == DiffusionModel::kTabulated) {
     gl::set_tabulated(radiance_program.id(), scene.material, kUnitTabulated, tabulated_rows);
   }
-  glProgramUniform1f(final_program.id(), final_program.location("u_eta"),
-                     float(scene.material.ior));
+  const GLuint f = final_program.id();
+  glProgramUniform1f(f, final_program.location("u_eta"), float(scene.material.ior));
+  const detail::SingleMedium single = detail::SingleMedium::of(scene.material);
+  const auto vec3 = [&](const char* name, const std::array<double, 3>& v) {
+    glProgramUniform3f(f, final_program.location(name), float(v[0]), float(v[1]), float(v[2]));
+  };
+  vec3("u_single_sigma_s", single.sigma_s);
+  vec3("u_single_sigma_t", single.sigma_t);
+  vec3("u_single_g", single.g);
+  glProgramUniform1i(f, final_program.location("u_single_steps"), detail::kSingleScatteringSteps);
   // sigma* depends on the material: the disc is rebuilt with the lights.
   upload_lights();
 }
@@ -504,10 +514,15 @@ void RadianceMapRenderer::Impl::render_final() {
               final.has_environment() && options.environment_reflection ? 1 : 0);
   glUniform1f(final_program.location("u_roughness"), scene.roughness);
   glUniform1i(final_program.location("u_specular"), scene.specular ? 1 : 0);
+  glUniform1i(final_program.location("u_single_scattering"), scene.single_scattering ? 1 : 0);
   glBindBufferBase(GL_UNIFORM_BUFFER, kLayerCamerasBinding, layer_cameras.id());
   glBindBufferBase(GL_UNIFORM_BUFFER, kLightMatricesBinding, light_matrices.id());
   glBindTextureUnit(kUnitLightPositionsFinal, light_positions.id());
   glBindSampler(kUnitLightPositionsFinal, nearest.id());
+  glBindTextureUnit(kUnitLightNormalsFinal, light_normals.id());
+  glBindSampler(kUnitLightNormalsFinal, nearest.id());
+  glBindTextureUnit(kUnitLightFaceNormalsFinal, light_face_normals.id());
+  glBindSampler(kUnitLightFaceNormalsFinal, nearest.id());
   glBindTextureUnit(kUnitRadiance, radiance[current].id());
   glBindSampler(kUnitRadiance, mip_nearest.id());
   glBindTextureUnit(kUnitRadianceDepth, radiance_depth.id());

@@ -207,6 +207,9 @@ ImageRgb render_radiance_maps(const Scene& scene, const RenderSettings& settings
         {"convergence_tolerance", options.convergence_tolerance},
         {"frame_change", s.frame_change},
         {"uncovered_fraction", s.uncovered_fraction},
+        // The final pass's quadrature of Jensen's single scattering (single_scattering.glsl).
+        {"single_scattering", scene.single_scattering},
+        {"single_scattering_steps", scene.single_scattering ? detail::kSingleScatteringSteps : 0},
         {"sigma_star_per_mm", s.sigma_star_per_mm},
         {"disc_radius_mm", s.disc_radius_mm},
         {"used_disc_radius_mm", s.used_disc_radius_mm},

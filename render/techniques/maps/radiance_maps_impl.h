@@ -20,6 +20,7 @@
 #include "lucent/render/gl_context.h"
 #include "lucent/render/radiance_maps.h"
 #include "radiance_maps_sampling.h"
+#include "single_scattering.h"
 
 namespace lucent::render {
 namespace maps_detail {
@@ -29,7 +30,8 @@ constexpr int kMaxLights = 16;
 constexpr GLuint kUnitLightPositions = 0, kUnitLightNormals = 1, kUnitPrevious = 2,
                  kUnitTabulated = 3, kUnitLightFaceNormals = 4;
 constexpr GLuint kUnitRadiance = 0, kUnitRadianceDepth = 1, kUnitEnvironment = 2,
-                 kUnitLightPositionsFinal = 3;
+                 kUnitLightPositionsFinal = 3, kUnitLightNormalsFinal = 4,
+                 kUnitLightFaceNormalsFinal = 5;
 // Uniform-block bindings (as in the shaders).
 constexpr GLuint kLightMatricesBinding = 0, kLayerCamerasBinding = 1, kDiscSamplesBinding = 2;
 

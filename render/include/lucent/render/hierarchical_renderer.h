@@ -47,6 +47,9 @@ class HierarchicalRenderer final : public Technique {
   const hierarchical::Stats& stats() const;  ///< the solve's, last frame
   double upload_ms() const;         ///< last frame's B upload
   double draw_ms() const;           ///< last frame's draw (glFinish + wall clock)
+  /// The last computation of the per-vertex single scattering (Scene::single_scattering), wall
+  /// clock; 0 when off. Redone when the eye, lights, material or geometry change.
+  double single_scattering_ms() const;
   const hierarchical::Solver& solver() const;
 
   /// The last frame's passes (the solve's stages, the upload, the draw) and its links.

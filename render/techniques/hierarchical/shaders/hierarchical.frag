@@ -1,6 +1,7 @@
 #version 450 core
 // lucent GLSL 1: the hierarchical technique's shading (Mertens et al. eq. 3): L = (1 / pi) F_t(eta,
-// n . w_o) B, B interpolated from the vertices, plus every light's GGX lobe (unshadowed: the CPU
+// n . w_o) B, B interpolated from the vertices, plus (lucent) the single scattering the CPU
+// computed at the vertices, plus every light's GGX lobe (unshadowed: the CPU
 // shadows the irradiance only) and, with an environment map, its Fresnel reflection.
 #include "math.glsl"
 #include "fresnel.glsl"
@@ -14,6 +15,7 @@
 in vec3 f_position;
 in vec3 f_normal;
 in vec3 f_B;
+in vec3 f_single;  // hierarchical_single.h: Jensen's term at the vertices (F_t, 1 / eta^2 included)
 layout(location = 0) out vec4 out_color;
 
 uniform vec3 u_eye;  // mm
@@ -34,7 +36,7 @@ void main() {
   if (dot(n_o, w_o) < 0.0) n_o = -n_o;  // interpolated normals of silhouette triangles
   float cos_o = dot(n_o, w_o);
   float F_r = fresnel_reflectance(cos_o, u_eta);
-  vec3 L = (1.0 - F_r) / kPi * max(f_B, vec3(0.0));
+  vec3 L = (1.0 - F_r) / kPi * max(f_B, vec3(0.0)) + max(f_single, vec3(0.0));
   // The mirror direction's light crosses a fur coat too (cos_i = cos_o there; T = 1 without one).
   if (u_has_environment) {
     L += F_r * fur_coat(cos_o) * environment_lookup(u_environment, reflect(-w_o, n_o));

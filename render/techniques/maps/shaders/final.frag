@@ -2,7 +2,8 @@
 // lucent GLSL 1: step 3 of Dal Corso 2014 (§5.2 "Combination", §5.3.5, §5.4.4): the subsurface radiance at
 // x_o is the mean, over the layers k whose camera sees x_o, of layer k's gathered sum divided by its
 // frame count (alpha), weighted by n_o . w_k (lucent: the seed weighs layers equally), read at the blur level chosen from the frame count; then
-//   L(x_o, w_o) = F_t(eta, n_o . w_o) L_ss + F_r(eta, n_o . w_o) L_env(reflect(-w_o, n_o)).
+//   L(x_o, w_o) = F_t(eta, n_o . w_o) L_ss + F_r(eta, n_o . w_o) L_env(reflect(-w_o, n_o)),
+// plus (lucent) the single scattering of the point and directional lights (single_scattering.glsl).
 // "Sees" is a shadow-map test against layer k's depth (sampler2DArrayShadow), at x_o shrunk by eps_c
 // toward the layer's view axis in the layer plane, x_o - eps_c (n_o - w_k (n_o . w_k)), against the
 // seams of seed Figure 5.18. Two changes to the seed's test: the shrink moves x_o sideways under a
@@ -17,6 +18,7 @@
 #include "environment.glsl"
 #include "specular.glsl"
 #include "fur_coat.glsl"
+#include "single_scattering.glsl"
 #ifdef LUCENT_AREA_LIGHTS
 #include "area_light.glsl"
 #endif
@@ -55,6 +57,15 @@ uniform vec2 u_light_texel_mm[LUCENT_MAX_LIGHTS];
 uniform sampler2DArray u_light_positions;
 uniform float u_roughness;  // GGX alpha; 0: no lobe from point or directional lights
 uniform bool u_specular;
+// The single-scattering term (Scene::single_scattering): the medium and the quadrature's steps; the
+// light maps' normals give the light's entry point.
+uniform bool u_single_scattering;
+uniform vec3 u_single_sigma_s;  // mm^-1
+uniform vec3 u_single_sigma_t;  // mm^-1
+uniform vec3 u_single_g;
+uniform int u_single_steps;
+uniform sampler2DArray u_light_normals;       // shading normals of the light maps' surfaces
+uniform sampler2DArray u_light_face_normals;  // their triangles' planes
 
 // Whether light l reaches x_o: the light map's nearest surface on x_o's ray toward the light is
 // x_o itself (within a slope-scaled bias of a few light-map texels) and not something in front.
@@ -71,6 +82,39 @@ bool lit_by(int l, vec3 x_o, vec3 n_o, vec3 w) {
   float cos_i = max(dot(n_o, w), 0.05);
   float bias = 2.0 * texel * (1.0 + min(sqrt(1.0 - cos_i * cos_i) / cos_i, 8.0));
   return dot(p.xyz - x_o, w) <= bias;
+}
+
+// The light's entry point from x (inside) toward light l: the light map's surface in x's texel,
+// its distance along w to the plane of that surface's triangle (the texel's position alone would be
+// off by up to a texel times the slope), and its shading normal. No surface there: x is outside.
+bool single_scattering_entry(int l, vec3 x, vec3 w, out float distance_mm, out vec3 normal) {
+  distance_mm = 0.0;
+  normal = w;
+  vec4 clip = u_light_view_proj[l] * vec4(x, 1.0);
+  if (clip.w <= 0.0) return false;
+  vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
+  if (any(lessThan(uv, vec2(0.0))) || any(greaterThanEqual(uv, vec2(1.0)))) return false;
+  vec2 size = vec2(textureSize(u_light_positions, 0).xy);
+  ivec3 texel = ivec3(ivec2(uv * size), l);
+  vec4 p = texelFetch(u_light_positions, texel, 0);
+  if (p.w < 0.5) return false;
+  vec3 plane = texelFetch(u_light_face_normals, texel, 0).xyz;
+  normal = texelFetch(u_light_normals, texel, 0).xyz;
+  float along = dot(w, plane);
+  distance_mm = along > 0.05 ? dot(p.xyz - x, plane) / along : dot(p.xyz - x, w);
+  return true;
+}
+
+// Every point and directional light's single scattering (area lights have none here).
+vec3 single_scattering_lights(vec3 x_o, vec3 n_o, vec3 w_o) {
+  SingleMedium m = SingleMedium(u_single_sigma_s, u_single_sigma_t, u_single_g, u_eta);
+  vec3 sum = vec3(0.0);
+  for (int l = 0; l < u_light_count; ++l) {
+    if (u_light_position[l].w > 1.5) continue;
+    sum += single_scattering_radiance(m, x_o, n_o, w_o, l, u_light_position[l],
+                                      u_light_radiance[l], u_single_steps);
+  }
+  return sum;
 }
 
 vec3 specular_lights(vec3 x_o, vec3 n_o, vec3 w_o) {
@@ -133,6 +177,7 @@ void main() {
   if (u_has_environment && u_specular) {  // --specular off: the subsurface term alone
     L += F_r * fur_coat(dot(n_o, w_o)) * environment_lookup(u_environment, reflect(-w_o, n_o));
   }
+  if (u_single_scattering) L += single_scattering_lights(x_o, n_o, w_o);
   L += specular_lights(x_o, n_o, w_o);
   out_color = vec4(L, seen > 0.0 ? 1.0 : 0.5);
 }

@@ -1,0 +1,117 @@
+// The single-scattering term of Jensen et al. 2001 (seed 000 §2.4, eq. 4 with its refracted path
+// length s_i'), evaluated by a fixed quadrature along the refracted view ray. This is the C++ twin
+// of render/gl/shaders/single_scattering.glsl: the radiance maps' final pass evaluates that one
+// with the light maps as `entry`, the hierarchical technique evaluates this one at its vertices
+// with Embree rays. (The reference and pathtrace draw the same term by Monte Carlo with the exact
+// refracted connection: render/pathtrace/path_walk.h.)
+//
+// Radiance leaving x_o toward w_o from one collision inside, per channel c:
+//   L_c = F_t(cos_o) / eta^2  integral_0^inf  sigma_s p_g(d_in . -t) E_in e^(-sigma_t s_i')
+//   e^(-sigma_t s) ds
+// t the refracted view ray (into the medium), x = x_o + s t; the light's entry point x_i is where
+// the straight line from x toward the light leaves the medium, at distance s_i, normal n_i;
+//   s_i' = s_i cos_i / cos_ti         (Jensen's refracted path length: exact for a plane),
+//   E_in = E F_t(cos_i) cos_i / cos_ti (the refracted beam's irradiance across itself),
+// d_in the refracted travel direction at x_i. The quadrature substitutes u = 1 - e^(-sigma_t s) and
+// takes the midpoints of `steps` equal strata of u: exact (to rounding) for a plane lit and seen
+// along its normal, where the integrand is linear in u; within 0.5% for a plane lit and seen at
+// 60 degrees with 8 steps (tests/render/single_scattering_test.cpp holds it to the closed form).
+// Stated approximations: a curved boundary is the plane at x_i (Jensen's); a point light's entry is
+// on the straight line; points beyond the object's far side count as inside when `entry` finds a
+// surface toward the light (negligible beyond a few mean free paths).
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cmath>
+#include <numbers>
+
+#include "lucent/materials/fresnel.h"
+#include "lucent/materials/material.h"
+
+namespace lucent::render::detail {
+
+/// The medium per channel: sigma_s, sigma_t (mm^-1), the Henyey-Greenstein g; relative index eta.
+struct SingleMedium {
+  std::array<double, 3> sigma_s{}, sigma_t{}, g{};
+  double eta = 1;
+  static SingleMedium of(const materials::Material& material) {
+    SingleMedium m;
+    m.eta = material.ior;
+    for (int c = 0; c < 3; ++c) {
+      const materials::Medium<double> medium = material.medium(c);
+      m.sigma_s[std::size_t(c)] = medium.sigma_s;
+      m.sigma_t[std::size_t(c)] = medium.sigma_a + medium.sigma_s;
+      m.g[std::size_t(c)] = medium.g;
+    }
+    return m;
+  }
+};
+
+/// What lies toward the light from a point x inside: the distance (mm) along the straight line to
+/// where it leaves the medium and the surface's outward shading normal there; found false when no
+/// surface is there (x is outside).
+struct LightEntry {
+  bool found = false;
+  double distance_mm = 0;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+};
+
+/// One light: directional (`toward` the unit direction toward it, `radiance` the irradiance on a
+/// surface facing it) or point (`toward` its position in mm, `radiance` its intensity).
+struct SingleLight {
+  bool point = false;
+  Eigen::Vector3d toward = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d radiance = Eigen::Vector3d::Ones();
+};
+
+constexpr int kSingleScatteringSteps = 8;
+
+/// Henyey-Greenstein density per steradian of turning by cos_theta.
+inline double henyey_greenstein(double g, double cos_theta) {
+  const double d = 1 + g * g - 2 * g * cos_theta;
+  return (1 - g * g) / (4 * std::numbers::pi * d * std::sqrt(d));
+}
+
+/// The single-scattering radiance (per channel) leaving x_o (outward normal n_o) toward the unit
+/// w_o lit by `light`; `entry(x, w)` -> LightEntry finds the light's entry point from x toward w.
+template <typename Entry>
+Eigen::Vector3d single_scattering_radiance(const SingleMedium& m, const Eigen::Vector3d& x_o,
+                                           const Eigen::Vector3d& n_o, const Eigen::Vector3d& w_o,
+                                           const SingleLight& light, int steps, Entry&& entry) {
+  Eigen::Vector3d L = Eigen::Vector3d::Zero();
+  const double cos_o = n_o.dot(w_o);
+  if (!(cos_o > 0)) return L;
+  const double eta = m.eta;
+  const double cos_to = std::sqrt(std::max(0.0, 1 - (1 - cos_o * cos_o) / (eta * eta)));
+  const Eigen::Vector3d t = -w_o / eta + (cos_o / eta - cos_to) * n_o;  // into the medium
+  const double leaving = materials::fresnel_transmittance(cos_o, eta) / (eta * eta);
+  for (int c = 0; c < 3; ++c) {
+    const double sigma_t = m.sigma_t[std::size_t(c)];
+    if (!(sigma_t > 0)) continue;
+    double sum = 0;
+    for (int k = 0; k < steps; ++k) {
+      const double u = (k + 0.5) / steps;
+      const double s = -std::log1p(-u) / sigma_t;
+      const Eigen::Vector3d x = x_o + s * t;
+      const Eigen::Vector3d w =
+          light.point ? Eigen::Vector3d((light.toward - x).normalized()) : light.toward;
+      const LightEntry e = entry(x, w);
+      if (!e.found || !(e.distance_mm >= 0)) continue;
+      const double cos_i = w.dot(e.normal);
+      if (!(cos_i > 0)) continue;  // the surface there faces away from the light
+      const double cos_ti = std::sqrt(std::max(0.0, 1 - (1 - cos_i * cos_i) / (eta * eta)));
+      const double s_in = e.distance_mm * cos_i / cos_ti;
+      double E = light.radiance[c];
+      if (light.point) E /= std::max((light.toward - (x + e.distance_mm * w)).squaredNorm(), 1e-12);
+      const double E_in = E * materials::fresnel_transmittance(cos_i, eta) * cos_i / cos_ti;
+      const Eigen::Vector3d d_in = -w / eta + (cos_i / eta - cos_ti) * e.normal;
+      const double phase = henyey_greenstein(m.g[std::size_t(c)], -d_in.dot(t));
+      sum += m.sigma_s[std::size_t(c)] * phase * E_in * std::exp(-sigma_t * s_in);
+    }
+    L[c] = leaving * sum / (steps * sigma_t);
+  }
+  return L;
+}
+
+}  // namespace lucent::render::detail
