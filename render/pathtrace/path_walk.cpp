@@ -168,19 +168,33 @@ namespace {
 // distance s when it ends in a collision before `boundary` mm, with the channels' weights
 // sigma_s e^(-sigma_t s) / mixture density folded into beta; false when it reaches the boundary
 // first, with e^(-sigma_t boundary) / the probability of getting there folded in.
-bool free_path(const MediumRgb& m, const Rgb& share, double boundary, Random& random, Rgb& beta,
-               double& s) {
+// In two steps, for the caller that tests the segment before it looks for the boundary: the
+// distance (draw_free_path), then its weight once it is known to end in a collision
+// (collision_weight) or to reach the boundary first (boundary_weight).
+double draw_free_path(const MediumRgb& m, const Rgb& share, Random& random) {
   const int k = pick_channel(share, random.uniform());
   const double sigma = m.sigma_t[k];
-  s = sigma > 0 ? -std::log(1 - random.uniform()) / sigma : std::numeric_limits<double>::infinity();
-  if (s < boundary) {
-    const Rgb survive = (-m.sigma_t * s).exp();
-    const double pdf = (share * m.sigma_t * survive).sum();
-    beta *= m.sigma_s * survive / pdf;
-    return true;
-  }
+  return sigma > 0 ? -std::log(1 - random.uniform()) / sigma
+                   : std::numeric_limits<double>::infinity();
+}
+void collision_weight(const MediumRgb& m, const Rgb& share, double s, Rgb& beta) {
+  const Rgb survive = (-m.sigma_t * s).exp();
+  const double pdf = (share * m.sigma_t * survive).sum();
+  beta *= m.sigma_s * survive / pdf;
+}
+void boundary_weight(const MediumRgb& m, const Rgb& share, double boundary, Rgb& beta) {
   const Rgb survive = (-m.sigma_t * boundary).exp();
   beta *= survive / (share * survive).sum();
+}
+
+bool free_path(const MediumRgb& m, const Rgb& share, double boundary, Random& random, Rgb& beta,
+               double& s) {
+  s = draw_free_path(m, share, random);
+  if (s < boundary) {
+    collision_weight(m, share, s, beta);
+    return true;
+  }
+  boundary_weight(m, share, boundary, beta);
   return false;
 }
 
@@ -405,30 +419,41 @@ Rgb trace_path(const World& w, const Vec3d& eye, const Vec3d& direction, const R
   p.o = p.last = eye;
   p.d = direction;
   for (;;) {
-    const auto hit = w.boundary.hit(p.o, p.d);
-    if (!p.inside) {
-      add_area_emitters(w, p, hit);
-      if (!hit) {
-        add_escape(w, p);
-        return p.radiance;
+    if (p.inside) {
+      // The free path first: most end inside, where an occlusion query over the segment (which
+      // stops at its end) costs less than finding the boundary beyond it.
+      const Rgb share = shares_of(p.beta);
+      const double s = draw_free_path(w.medium, share, random);
+      if (std::isfinite(s) && s > p.head && !w.boundary.occluded(p.o, p.d, s - p.head)) {
+        collision_weight(w.medium, share, s, p.beta);
+        if (!collide(w, p, p.o + (s - p.head) * p.d, random, counts)) return p.radiance;
+        continue;
       }
-      if (p.d.dot(hit->ng) > 0) {  // the inside of the mesh, seen from outside: an open mesh
+      const auto hit = w.boundary.hit(p.o, p.d);
+      if (!hit || p.d.dot(hit->ng) < 0) {  // no way out, or a face seen from inside: a leak
         ++counts.leaks;
         return p.radiance;
       }
-      if (!enter(w, p, *hit, random)) return p.radiance;
+      if (s < p.head + hit->t) {  // the query and the hit disagree by rounding at the end
+        collision_weight(w.medium, share, s, p.beta);
+        if (!collide(w, p, p.o + (s - p.head) * p.d, random, counts)) return p.radiance;
+        continue;
+      }
+      boundary_weight(w.medium, share, p.head + hit->t, p.beta);
+      leave(w, p, *hit, random);
       continue;
     }
-    if (!hit || p.d.dot(hit->ng) < 0) {  // no way out, or a face seen from inside: a leak
+    const auto hit = w.boundary.hit(p.o, p.d);
+    add_area_emitters(w, p, hit);
+    if (!hit) {
+      add_escape(w, p);
+      return p.radiance;
+    }
+    if (p.d.dot(hit->ng) > 0) {  // the inside of the mesh, seen from outside: an open mesh
       ++counts.leaks;
       return p.radiance;
     }
-    double s = 0;
-    if (free_path(w.medium, shares_of(p.beta), p.head + hit->t, random, p.beta, s)) {
-      if (!collide(w, p, p.o + (s - p.head) * p.d, random, counts)) return p.radiance;
-      continue;
-    }
-    leave(w, p, *hit, random);
+    if (!enter(w, p, *hit, random)) return p.radiance;
   }
 }
 
