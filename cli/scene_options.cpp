@@ -120,7 +120,13 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
   cmd->add_option("--single-scattering", args->single_scattering,
                   "auto, on or off: the single-scattering term (Jensen et al. 2001) beside the "
                   "BSSRDF's multiple scattering, in the techniques that have it (auto: where "
-                  "they do: the reference; the path tracer's transport always holds it)")
+                  "they do: the reference, maps and hierarchical; the path tracer's transport "
+                  "always holds it)")
+      ->capture_default_str();
+  cmd->add_option("--angular", args->angular,
+                  "on or off: the multiple scattering's dependence on the angles of incidence and "
+                  "exit beyond Fresnel (Chandrasekhar's H-function of the reduced albedo) for the "
+                  "radial models (tabulated, dipole) in the reference, maps and hierarchical")
       ->capture_default_str();
   cmd->add_option("--backdrop", args->backdrop,
                   "R,G,B: radiance of the background where there is no environment map "
@@ -220,6 +226,9 @@ void check_options(SceneArguments& args, const render::TechniqueInfo& technique)
     throw Error("--single-scattering: expected auto, on or off, got '" + args.single_scattering +
                 "'");
   }
+  if (args.angular != "on" && args.angular != "off") {
+    throw Error("--angular: expected on or off, got '" + args.angular + "'");
+  }
   if (args.single_scattering == "on" && !technique.single_scattering) {
     throw Error("--single-scattering: the " + technique.name +
                 " technique has no single-scattering term yet; use --single-scattering off or auto");
@@ -309,7 +318,9 @@ SceneSetup build_scene(SceneArguments& args) {
   }
   scene.roughness = args.roughness;
   scene.specular = args.specular == "on";
-  scene.single_scattering = args.single_scattering != "off" && technique.single_scattering;
+  // Techniques without the term ignore it; the viewer's switch reaches those with it.
+  scene.single_scattering = args.single_scattering != "off";
+  scene.angular = args.angular == "on";
   scene.backdrop = backdrop;
   if (args.fur_coat == "on")
     scene.fur_coat = render::fur::make_fur_coat(render::fur::over_mesh(o.fur));

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "lucent/core/error.h"
+#include "lucent/materials/angular.h"
 #include "lucent/materials/fresnel.h"
 #include "lucent/materials/radial_slices.h"
 #include "lucent/materials/tabulated.h"
@@ -98,6 +99,18 @@ void set_bssrdf_uniforms(GLuint program, const materials::Material& material) {
     set(s + "z_v", sd.z_v);
   }
   set("u_eta", float(material.ior));
+}
+
+void set_angular_uniforms(GLuint program, const materials::Material& material, bool on) {
+  glProgramUniform1i(program, glGetUniformLocation(program, "u_angular"), on ? 1 : 0);
+  if (!on) return;
+  const materials::AngularFactor factor(material);
+  constexpr int n = materials::AngularFactor::kNodes;
+  std::vector<float> nodes(std::size_t(n) * 3);
+  for (int i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c)
+      nodes[std::size_t(3 * i + c)] = float(factor.nodes(c)[std::size_t(i)]);
+  glProgramUniform3fv(program, glGetUniformLocation(program, "u_angular_nodes"), n, nodes.data());
 }
 
 void set_fur_coat_uniforms(GLuint program, const std::optional<FurCoat>& coat) {

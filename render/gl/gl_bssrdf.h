@@ -57,4 +57,8 @@ inline constexpr int kMaxFurCoatNodes = 32;  ///< LUCENT_MAX_FUR_COAT_NODES of f
 /// 0 nodes (T = 1) without one. Throws lucent::Error for a coat of more than kMaxFurCoatNodes.
 void set_fur_coat_uniforms(GLuint program, const std::optional<FurCoat>& coat);
 
+/// Sets `u_angular` and `u_angular_nodes` (angular.glsl) in `program`: the material's angular
+/// factor of multiple scattering (materials/angular.h) when `on`, else off (a factor of 1).
+void set_angular_uniforms(GLuint program, const materials::Material& material, bool on);
+
 }  // namespace lucent::render::gl

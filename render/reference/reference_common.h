@@ -23,6 +23,7 @@
 #include <Eigen/Geometry>
 
 #include "lucent/core/error.h"
+#include "lucent/materials/angular.h"
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/directional_dipole.h"
 #include "lucent/materials/fresnel.h"
@@ -101,10 +102,19 @@ Vec3f specular_radiance(const Scene& scene, const RayScene& rays, const PixelHit
 
 class IrradianceCache;
 
+/// The angular factor of multiple scattering when the scene asks for it (Scene::angular) and the
+/// model is radial (the directional dipole has its own dependence on the incidence); else null.
+inline std::unique_ptr<materials::AngularFactor> angular_factor_for(const Scene& scene,
+                                                                    DiffusionModel model) {
+  if (!scene.angular || model == DiffusionModel::kDirectionalDipole) return nullptr;
+  return std::make_unique<materials::AngularFactor>(scene.material);
+}
+
 /// `cache`: area lights' irradiance from it (else shadow rays per hit); may be null.
+/// `angular`: the incidence side's angular factor at each hit (may be null).
 void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions& options,
                 const RayScene& rays, const IrradianceCache* cache,
-                const std::vector<PixelHit>& hits,
+                const materials::AngularFactor* angular, const std::vector<PixelHit>& hits,
                 const std::vector<std::uint32_t>& object_pixels, int pass, int threads,
                 std::vector<std::array<double, 3>>& accumulated, std::uint64_t& probe_hits,
                 const std::function<void(std::size_t)>& on_progress);

@@ -51,7 +51,14 @@ struct ProbeShading {
   AreaLightSampling area_sampling;
   float eps;
   double eta;
+  const materials::AngularFactor* angular;  // null: the radial model's F_t alone
 };
+
+// The incidence side's angular factor per channel (1 without one).
+std::array<double, 3> incidence_factor(const materials::AngularFactor* angular, double cos_i) {
+  if (angular == nullptr) return {1, 1, 1};
+  return {(*angular)(0, cos_i), (*angular)(1, cos_i), (*angular)(2, cos_i)};
+}
 
 void add_hit(const ProbeShading& ps, unsigned tri, const Vec3f& x_f, const Vec3f& g_f,
              const Vec3f& n_f, const Vec3d& x_o, const Vec3d& n_o, double pdf, std::uint64_t key,
@@ -74,9 +81,10 @@ void add_hit(const ProbeShading& ps, unsigned tri, const Vec3f& x_f, const Vec3f
     Vec3f w_cache;
     const auto E = cache->lookup(tri, x_f, &w_cache);
     const Vec3d w_i = w_cache.cast<double>();
+    const std::array<double, 3> k = incidence_factor(ps.angular, n_i.dot(w_i));
     for (int c = 0; c < 3; ++c) {
       const double s_d = per_light ? bssrdf[c](x_i, n_i, w_i, x_o, n_o) : radial[c];
-      sum[c] += E[std::size_t(c)] / pdf * s_d;
+      sum[c] += E[std::size_t(c)] / pdf * s_d * k[c];
     }
   }
   for (std::size_t l = 0; l < scene.lights.size(); ++l) {
@@ -89,9 +97,10 @@ void add_hit(const ProbeShading& ps, unsigned tri, const Vec3f& x_f, const Vec3f
       if (a.transmitted == 0) continue;
       const Vec3d w_i = a.w.cast<double>();
       const double factor = a.transmitted / pdf;
+      const std::array<double, 3> k = incidence_factor(ps.angular, n_i.dot(w_i));
       for (int c = 0; c < 3; ++c) {
         const double s_d = per_light ? bssrdf[c](x_i, n_i, w_i, x_o, n_o) : radial[c];
-        sum[c] += factor * light.radiance[c] * s_d;
+        sum[c] += factor * light.radiance[c] * s_d * k[c];
       }
       continue;
     }
@@ -107,9 +116,10 @@ void add_hit(const ProbeShading& ps, unsigned tri, const Vec3f& x_f, const Vec3f
     const double factor = scale * cos_i * materials::fresnel_transmittance(cos_i, eta) *
                           (scene.fur_coat ? scene.fur_coat->at(cos_i) : 1.0) / pdf;
     const Vec3d w_i = w.cast<double>();
+    const std::array<double, 3> k = incidence_factor(ps.angular, cos_i);
     for (int c = 0; c < 3; ++c) {
       const double s_d = per_light ? bssrdf[c](x_i, n_i, w_i, x_o, n_o) : radial[c];
-      sum[c] += factor * light.radiance[c] * s_d;
+      sum[c] += factor * light.radiance[c] * s_d * k[c];
     }
   }
 }
@@ -118,7 +128,7 @@ void add_hit(const ProbeShading& ps, unsigned tri, const Vec3f& x_f, const Vec3f
 
 void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions& options,
                 const RayScene& rays, const IrradianceCache* cache,
-                const std::vector<PixelHit>& hits,
+                const materials::AngularFactor* angular, const std::vector<PixelHit>& hits,
                 const std::vector<std::uint32_t>& object_pixels, int pass, int threads,
                 std::vector<std::array<double, 3>>& accumulated, std::uint64_t& probe_hits,
                 const std::function<void(std::size_t)>& on_progress) {
@@ -139,7 +149,7 @@ void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions
       mix(options.seed * 0xD1B54A32D192ED03ull + std::uint64_t(pass) * 0x9E3779B97F4A7C15ull);
   std::atomic<std::uint64_t> total_hits{0};
   const ProbeShading shading{scene,     options,       rays, cache, bssrdf,
-                             per_light, area_sampling, eps,  eta};
+                             per_light, area_sampling, eps,  eta,   angular};
 
   parallel_for(
       object_pixels.size(), threads, 8,

@@ -143,6 +143,7 @@ void HierarchicalRenderer::setup(const Scene& scene, const hierarchical::Options
   m.fit_bounds();
   m.upload_lights();
   glProgramUniform1f(m.program.id(), m.program.location("u_eta"), float(scene.material.ior));
+  gl::set_angular_uniforms(m.program.id(), scene.material, scene.angular);
   gl::check_errors("hierarchical setup");
 }
 
@@ -173,6 +174,7 @@ void HierarchicalRenderer::set_material(const materials::Material& material) {
   m.solver->set_material(material);
   m.single_valid = false;
   glProgramUniform1f(m.program.id(), m.program.location("u_eta"), float(material.ior));
+  gl::set_angular_uniforms(m.program.id(), material, m.scene.angular);
 }
 
 void HierarchicalRenderer::set_geometry(const std::vector<Vec3f>& positions,
@@ -298,6 +300,7 @@ ImageRgb render_hierarchical(const Scene& scene, const hierarchical::Options& op
                       {"point_samples", s.point_samples},
                       {"edge_segments", s.edge_segments},
                       {"single_scattering", scene.single_scattering},
+                      {"angular", scene.angular},
                       {"timing", "one frame from scratch (hierarchy, links, solve), wall clock"},
                       {"options", options.to_string()}};
   }

@@ -7,12 +7,14 @@
 #include <cmath>
 #include <functional>
 #include <numbers>
+#include <optional>
 #include <sstream>
 #include <unordered_map>
 
 #include "area_light_irradiance.h"
 #include "irradiance_cache.h"
 #include "lucent/core/error.h"
+#include "lucent/materials/angular.h"
 #include "lucent/materials/fresnel.h"
 #include "lucent/materials/material.h"
 #include "reference_common.h"
@@ -121,8 +123,11 @@ struct Solver::Impl {
     for (int ch = 0; ch < 3; ++ch) c[std::size_t(ch)] = materials::derive_coefficients(m.medium(ch));
     if (eta != m.ior) cache.reset();  // the cached E_t carries F_t(eta)
     eta = m.ior;
+    angular.reset();
+    if (scene.angular) angular.emplace(m);  // the shader applies the exit side
     ++material_version;
   }
+  std::optional<materials::AngularFactor> angular;  // Scene::angular: the incidence side
 
   static double omega(const Eigen::Vector3d& x, const Cluster& e) {
     const double d = (x - e.midpoint).norm();
@@ -318,7 +323,10 @@ struct Solver::Impl {
               light, x, n, g, rays.get(), eps, eta, sampling,
               detail::mix(std::uint64_t(t) * 0x9E3779B97F4A7C15ull + l));
           const double f = std::max(a.transmitted, 0.0);
-          for (int ch = 0; ch < 3; ++ch) face_E[t][std::size_t(ch)] += f * light.radiance[ch];
+          const double cos_a = double(n.dot(a.w));
+          for (int ch = 0; ch < 3; ++ch)
+            face_E[t][std::size_t(ch)] +=
+                f * light.radiance[ch] * (angular ? (*angular)(ch, cos_a) : 1.0);
           continue;
         }
         Vec3f w;
@@ -332,7 +340,9 @@ struct Solver::Impl {
         }
         const double f = falloff * cos_i * materials::fresnel_transmittance(cos_i, eta) *
                          (scene.fur_coat ? scene.fur_coat->at(cos_i) : 1.0);
-        for (int ch = 0; ch < 3; ++ch) face_E[t][std::size_t(ch)] += f * light.radiance[ch];
+        for (int ch = 0; ch < 3; ++ch)
+          face_E[t][std::size_t(ch)] +=
+              f * light.radiance[ch] * (angular ? (*angular)(ch, cos_i) : 1.0);
       }
     }
   }

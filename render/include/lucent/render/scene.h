@@ -82,6 +82,11 @@ struct Scene {
   /// in the techniques that have one (technique.h: TechniqueInfo::single_scattering). The CLI's
   /// `--single-scattering` turns it on by default; a Scene made in code has the BSSRDF alone.
   bool single_scattering = false;
+  /// Give the radial BSSRDFs' multiple scattering (tabulated, dipole) its dependence on the angles
+  /// of incidence and exit (materials/angular.h: Chandrasekhar's H-function of the reduced albedo,
+  /// one factor per side) in the reference, the maps and the hierarchical technique. The CLI's
+  /// `--angular` turns it on by default; a Scene made in code has the radial BSSRDF alone.
+  bool angular = false;
   Vec3f backdrop{0, 0, 0};  ///< radiance of the background where no environment map is given
   /// A fur coat over the skin (fur_coat.h, an extension of Klotzli & Olano): the maps and the
   /// reference attenuate each light sample's transmitted irradiance by its T(n . w_i). `--fur-coat

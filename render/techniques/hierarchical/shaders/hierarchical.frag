@@ -8,6 +8,7 @@
 #include "environment.glsl"
 #include "specular.glsl"
 #include "fur_coat.glsl"
+#include "angular.glsl"
 #ifdef LUCENT_AREA_LIGHTS
 #include "area_light.glsl"
 #endif
@@ -36,7 +37,8 @@ void main() {
   if (dot(n_o, w_o) < 0.0) n_o = -n_o;  // interpolated normals of silhouette triangles
   float cos_o = dot(n_o, w_o);
   float F_r = fresnel_reflectance(cos_o, u_eta);
-  vec3 L = (1.0 - F_r) / kPi * max(f_B, vec3(0.0)) + max(f_single, vec3(0.0));
+  vec3 L = (1.0 - F_r) / kPi * angular_factor(cos_o) * max(f_B, vec3(0.0)) +
+           max(f_single, vec3(0.0));
   // The mirror direction's light crosses a fur coat too (cos_i = cos_o there; T = 1 without one).
   if (u_has_environment) {
     L += F_r * fur_coat(cos_o) * environment_lookup(u_environment, reflect(-w_o, n_o));

@@ -19,6 +19,7 @@
 #include "specular.glsl"
 #include "fur_coat.glsl"
 #include "single_scattering.glsl"
+#include "angular.glsl"
 #ifdef LUCENT_AREA_LIGHTS
 #include "area_light.glsl"
 #endif
@@ -172,7 +173,7 @@ void main() {
   vec3 L_ss = seen > 0.0 ? sum / seen : vec3(0.0);
   vec3 w_o = normalize(u_eye - x_o);
   float F_r = fresnel_reflectance(dot(n_o, w_o), u_eta);
-  vec3 L = (1.0 - F_r) * L_ss;
+  vec3 L = (1.0 - F_r) * angular_factor(dot(n_o, w_o)) * L_ss;
   // The mirror direction's light crosses a fur coat too (cos_i = cos_o there; T = 1 without one).
   if (u_has_environment && u_specular) {  // --specular off: the subsurface term alone
     L += F_r * fur_coat(dot(n_o, w_o)) * environment_lookup(u_environment, reflect(-w_o, n_o));

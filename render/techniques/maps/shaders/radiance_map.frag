@@ -34,6 +34,7 @@ layout(early_fragment_tests) in;
 #include "math.glsl"
 #include "fresnel.glsl"
 #include "fur_coat.glsl"
+#include "angular.glsl"
 #include "random.glsl"
 #include "bssrdf_ddipole.glsl"
 #include "bssrdf_dipole.glsl"
@@ -203,7 +204,8 @@ void main() {
       if (!is_area)
 #endif
       E *= cos_i / max(dot(n_plane, w_i), 0.15);
-      sum += sample_.z * fresnel_transmittance(cos_i, u_eta) * fur_coat(cos_i) * E * bssrdf(x_i, n_i, w_i, x_o, n_o);
+      sum += sample_.z * fresnel_transmittance(cos_i, u_eta) * fur_coat(cos_i) * E *
+             bssrdf(x_i, n_i, w_i, x_o, n_o) * angular_factor(cos_i);
     }
   }
   vec4 previous = u_has_previous ? texelFetch(u_previous, ivec3(texel, g_layer), 0) : vec4(0.0);
