@@ -210,9 +210,14 @@ void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions
                 const Vec3d& ax = axes[std::size_t(b)];
                 // |offset x a|, not sqrt(|offset|^2 - (offset . a)^2): on the far side of an
                 // object the difference cancels to rounding and a probe's own hit would get a
-                // radius of ~0 (no density) and a weight of 1e10.
+                // radius of ~0 (no density) and a weight of 1e10. The probe's own axis takes the
+                // density of the radius it drew: recomputed from a far hit's float position, a
+                // radius near the density's lower end (1e-4 mean free paths) fell below it by
+                // rounding, to a density of 0 and a weight of 1e8-1e9 (the fireflies, 40-70x their
+                // neighbours, of a back-lit skin1 sphere at 4096 probes).
                 const double r_b = offset.cross(ax).norm();
-                pdf += P[std::size_t(b)] * density.density_per_mm2(r_b) * std::abs(g_i.dot(ax));
+                const double p_b = b == a ? p_r : density.density_per_mm2(r_b);
+                pdf += P[std::size_t(b)] * p_b * std::abs(g_i.dot(ax));
               }
               if (!(pdf > 0)) continue;
               // Russian roulette on hits the profile gives little to (the far side of an object

@@ -379,4 +379,39 @@ TEST(ReferenceProbes, RotatingEverythingTogetherChangesNothingButNoise) {
 }
 
 }  // namespace
+// A back-lit skin1 sphere at eta 1 (light from behind and below the camera's left): a probe along
+// the normal that draws a radius near the density's lower end (1e-4 mean free paths) also hits the
+// far side of the sphere 35 mm away, whose radius recomputed from the float hit position fell
+// below that end, to a density of 0 and a weight of ~1e9: single pixels 40-185 times their
+// neighbours (185 at this seed before the fix; 5 after, where the shadow's edge is noisy).
+TEST(ReferenceProbes, FarSideHitsOfTinyRadiiMakeNoFireflies) {
+  Scene scene;
+  scene.mesh = load_mesh("sphere", 35);
+  scene.material = materials::load_material("skin1");
+  scene.material.ior = 1.0;
+  scene.lights = {parse_light("directional:-1,0.3,-0.5:1,1,1")};
+  scene.camera = orbit_camera(scene.mesh, 30, 20, 3.4f, 40, 40);
+  scene.specular = false;
+  ReferenceOptions options;
+  options.pixel_samples = 1024;
+  options.seed = 2;
+  options.threads = 2;
+  const ReferenceImage r = render_reference(scene, DiffusionModel::kTabulated, options);
+  const ImageRgb& im = r.image;
+  const auto lum = [&](int x, int y) { return im.at(x, y, 0) + im.at(x, y, 1) + im.at(x, y, 2); };
+  double worst = 0;
+  for (int y = 1; y + 1 < im.height; ++y) {
+    for (int x = 1; x + 1 < im.width; ++x) {
+      std::vector<double> around;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+          if (dx != 0 || dy != 0) around.push_back(lum(x + dx, y + dy));
+      std::nth_element(around.begin(), around.begin() + 4, around.end());
+      if (around[4] > 0) worst = std::max(worst, lum(x, y) / around[4]);
+    }
+  }
+  std::printf("brightest pixel over the median of its neighbours: %.1f\n", worst);
+  EXPECT_LT(worst, 20.0);
+}
+
 }  // namespace lucent::render
