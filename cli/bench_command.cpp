@@ -112,6 +112,7 @@ void register_fur_bench(CLI::App* bench) {
 void register_tradeoff_bench(CLI::App* bench) {
   auto tradeoff = std::make_shared<render::TradeoffBenchOptions>();
   auto sweep = std::make_shared<std::string>("full");
+  auto truth = std::make_shared<std::string>("pathtrace");
   CLI::App* tradeoff_cmd = bench->add_subcommand(
       "tradeoff",
       "Every technique (maps with each model, sh, hierarchical, the reference) over a sweep of "
@@ -121,8 +122,9 @@ void register_tradeoff_bench(CLI::App* bench) {
   tradeoff_cmd->add_option("--out-dir", tradeoff->out_dir, "output folder")->capture_default_str();
   tradeoff_cmd
       ->add_option("--scenes", tradeoff->scenes,
-                   "MESH/MATERIAL/LIGHTING, LIGHTING directional, point or env (a procedural "
-                   "sky); the first gets the full sweep")
+                   "MESH/MATERIAL/LIGHTING[/SIZE_MM], LIGHTING directional, point or env (a "
+                   "procedural sky), SIZE_MM the object's size (default 100); the first gets the "
+                   "full sweep")
       ->delimiter(',')
       ->capture_default_str();
   tradeoff_cmd->add_option("--sweep", *sweep, "full, short or tiny (knob settings per technique)")
@@ -130,15 +132,25 @@ void register_tradeoff_bench(CLI::App* bench) {
   tradeoff_cmd->add_option("--size", tradeoff->size, "image size, pixels square")
       ->capture_default_str();
   tradeoff_cmd
+      ->add_option("--truth", *truth,
+                   "pathtrace (the medium itself: each model's error included) or reference (the "
+                   "converged reference of the same model: the pipeline's error alone)")
+      ->capture_default_str();
+  tradeoff_cmd
+      ->add_option("--truth-samples", tradeoff->truth_samples,
+                   "paths per pixel of the path-traced truth")
+      ->capture_default_str();
+  tradeoff_cmd
       ->add_option("--reference-samples", tradeoff->reference_samples,
-                   "probes per pixel of the converged reference")
+                   "probes per pixel of the converged reference (--truth reference)")
       ->capture_default_str();
   tradeoff_cmd->add_option("--env-lights", tradeoff->env_lights, "lights for the environment map")
       ->capture_default_str();
   tradeoff_cmd->add_option("--threads", tradeoff->threads, "the reference's threads (0: all)")
       ->capture_default_str();
-  tradeoff_cmd->callback([tradeoff, sweep] {
+  tradeoff_cmd->callback([tradeoff, sweep, truth] {
     tradeoff->sweep = render::parse_tradeoff_sweep(*sweep);
+    tradeoff->truth = render::parse_tradeoff_truth(*truth);
     check_output_folder(tradeoff->out_dir / "tradeoff.csv");  // before the sweep, not after
     const auto rows = render::run_tradeoff_bench(*tradeoff, std::cout);
     std::cout << "bench tradeoff: " << rows.size() << " images; wrote "

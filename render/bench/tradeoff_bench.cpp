@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -20,6 +21,7 @@
 #include "lucent/render/gl_context.h"
 #include "lucent/render/hierarchical_renderer.h"
 #include "lucent/render/image_compare.h"
+#include "lucent/render/path_tracer.h"
 #include "lucent/render/radiance_maps.h"
 #include "lucent/render/reference_renderer.h"
 #include "lucent/render/scene.h"
@@ -28,24 +30,41 @@
 namespace lucent::render {
 
 void write_tradeoff_report(const std::vector<TradeoffRow>& rows, const std::string& machine,
-                           int reference_samples, const std::filesystem::path& out_dir);  // tradeoff_report.cpp
+                           const std::string& truth, int reference_samples,
+                           const std::filesystem::path& out_dir);  // tradeoff_report.cpp
 
 namespace {
 
 struct SceneSpec {
   std::string text, mesh, material, lighting;
+  double size_mm = 100;
 };
 
 SceneSpec parse_scene(const std::string& text) {
-  SceneSpec spec{text, "", "", ""};
-  const std::size_t a = text.find('/'), b = text.rfind('/');
-  if (a == std::string::npos || a == b) {
-    throw Error("--scenes: expected MESH/MATERIAL/LIGHTING (e.g. sphere/marble/point), got '" +
-                text + "'");
+  SceneSpec spec{text, "", "", "", 100};
+  std::vector<std::string> parts;
+  for (std::size_t start = 0;;) {
+    const std::size_t slash = text.find('/', start);
+    parts.push_back(text.substr(start, slash == std::string::npos ? slash : slash - start));
+    if (slash == std::string::npos) break;
+    start = slash + 1;
   }
-  spec.mesh = text.substr(0, a);
-  spec.material = text.substr(a + 1, b - a - 1);
-  spec.lighting = text.substr(b + 1);
+  if (parts.size() != 3 && parts.size() != 4) {
+    throw Error(
+        "--scenes: expected MESH/MATERIAL/LIGHTING[/SIZE_MM] (e.g. sphere/marble/point/30), "
+        "got '" +
+        text + "'");
+  }
+  spec.mesh = parts[0];
+  spec.material = parts[1];
+  spec.lighting = parts[2];
+  if (parts.size() == 4) {
+    char* end = nullptr;
+    spec.size_mm = std::strtod(parts[3].c_str(), &end);
+    if (parts[3].empty() || *end != '\0' || !(spec.size_mm >= 1 && spec.size_mm <= 10000)) {
+      throw Error("--scenes: '" + text + "': the size must be 1..10000 mm, got '" + parts[3] + "'");
+    }
+  }
   if (spec.lighting != "directional" && spec.lighting != "point" && spec.lighting != "env") {
     throw Error("--scenes: '" + text + "': lighting must be directional, point or env, got '" +
                 spec.lighting + "'");
@@ -79,8 +98,10 @@ EnvironmentMap procedural_sky() {
 Scene make_scene(const SceneSpec& spec, const std::string& mesh, const TradeoffBenchOptions& o) {
   Scene scene;
   scene.material = materials::load_material(spec.material);
-  scene.mesh = load_mesh(mesh, 100.0);
+  scene.mesh = load_mesh(mesh, spec.size_mm);
   scene.specular = false;  // the subsurface term alone: the lobe is the same in every technique
+  scene.single_scattering = true;  // as the CLI renders by default (techniques without it: none)
+  scene.angular = true;
   if (spec.lighting == "directional") {
     scene.lights = {parse_light("directional:1,0.5,0.5:1,1,1")};
   } else if (spec.lighting == "point") {
@@ -128,9 +149,39 @@ class SceneBench {
   }
 
  private:
+  // The truth every row is held to: the path tracer's image (one for every model) or the
+  // converged reference of the row's model.
   const ImageRgb& reference(DiffusionModel model) {
+    if (options_.truth == TradeoffTruth::kPathtrace) model = DiffusionModel::kTabulated;  // one key
     auto it = references_.find(model);
     if (it != references_.end()) return it->second;
+    if (options_.truth == TradeoffTruth::kPathtrace) {
+      PathTraceOptions p;
+      p.pixel_samples = options_.truth_samples;
+      p.seed = 1;
+      p.threads = options_.threads;
+      PathTraceImage image = render_pathtrace(scene_, p);
+      log_ << "  " << spec_.text << ": path-traced truth (" << p.pixel_samples
+           << " paths per pixel) in " << image.stats.total_ms / 1000 << " s\n";
+      mask_ = nonzero_mask(image.image);
+      // The truth's own noise relative to its mean, in compare_images's units: what every row's
+      // relative RMSE holds beside its own error (taken out in quadrature in row()).
+      double se2 = 0, sum = 0;
+      std::size_t n = 0;
+      for (int y = 0; y < image.image.height; ++y)
+        for (int x = 0; x < image.image.width; ++x) {
+          if (!mask_[std::size_t(y) * std::size_t(image.image.width) + std::size_t(x)]) continue;
+          for (int c = 0; c < 3; ++c) {
+            se2 += double(image.standard_error.at(x, y, c)) * image.standard_error.at(x, y, c);
+            sum += image.image.at(x, y, c);
+            ++n;
+          }
+        }
+      truth_noise_ = n > 0 && sum > 0 ? std::sqrt(se2 / double(n)) / (sum / double(n)) : 0.0;
+      log_ << "  " << spec_.text << ": the truth's own noise " << truth_noise_
+           << " of its mean per pixel (taken out of every row's RMSE in quadrature)\n";
+      return references_.emplace(model, std::move(image.image)).first->second;
+    }
     ReferenceOptions r;
     r.pixel_samples = options_.reference_samples;
     r.seed = 1;
@@ -151,7 +202,9 @@ class SceneBench {
     r.lighting = spec_.lighting, r.technique = technique;
     r.model = materials::to_string(model), r.setting = setting;
     r.triangles = long(mesh.triangles.size());
-    r.relative_rmse = d.relative_rmse;
+    // Against the path tracer, less its own noise in quadrature (the rows' error, not the truth's).
+    r.relative_rmse =
+        std::sqrt(std::max(d.relative_rmse * d.relative_rmse - truth_noise_ * truth_noise_, 0.0));
     for (int c = 0; c < 3; ++c) r.mean_ratio[c] = d.mean_ratio[c];
     try {
       const ScaledComparison s = compare_scaled(image, ref, mask_);
@@ -370,6 +423,7 @@ class SceneBench {
   const Scene scene_;
   std::map<DiffusionModel, ImageRgb> references_;
   std::vector<std::uint8_t> mask_;
+  double truth_noise_ = 0;  // the path-traced truth's relative noise per pixel; 0 for the reference
 };
 
 // "CPU model, N threads; OpenGL renderer" for the report.
@@ -395,6 +449,12 @@ TradeoffSweep parse_tradeoff_sweep(const std::string& text) {
   throw Error("--sweep: expected full, short or tiny, got '" + text + "'");
 }
 
+TradeoffTruth parse_tradeoff_truth(const std::string& text) {
+  if (text == "pathtrace") return TradeoffTruth::kPathtrace;
+  if (text == "reference") return TradeoffTruth::kReference;
+  throw Error("--truth: expected pathtrace or reference, got '" + text + "'");
+}
+
 double TradeoffRow::error() const { return scale_only() ? scaled_rmse : relative_rmse; }
 
 bool TradeoffRow::scale_only() const {
@@ -407,6 +467,10 @@ std::vector<TradeoffRow> run_tradeoff_bench(const TradeoffBenchOptions& options,
   if (options.scenes.empty()) throw Error("--scenes: give at least one scene");
   if (options.size < 8 || options.size > 1024) {
     throw Error("--size: expected 8..1024 pixels, got " + std::to_string(options.size));
+  }
+  if (options.truth_samples < 16) {
+    throw Error("--truth-samples: expected at least 16 paths per pixel, got " +
+                std::to_string(options.truth_samples));
   }
   if (options.reference_samples < 16) {
     throw Error("--reference-samples: expected at least 16 probes per pixel, got " +
@@ -427,7 +491,18 @@ std::vector<TradeoffRow> run_tradeoff_bench(const TradeoffBenchOptions& options,
                device)
         .run();
   }
-  write_tradeoff_report(rows, machine_description(device), options.reference_samples,
+  const std::string truth =
+      options.truth == TradeoffTruth::kPathtrace
+          ? "the path-traced truth (--technique pathtrace, " +
+                std::to_string(options.truth_samples) +
+                " paths per pixel: the medium itself, so the error includes each model's; its own "
+                "per-pixel noise, from its standard errors, taken out of every RMSE in "
+                "quadrature); every technique with its single scattering and angular factor "
+                "where it has them"
+          : "a converged CPU reference of " + std::to_string(options.reference_samples) +
+                " probes per pixel, same scene and model";
+  write_tradeoff_report(rows, machine_description(device), truth,
+                        options.truth == TradeoffTruth::kReference ? options.reference_samples : 0,
                         options.out_dir);
   return rows;
 }

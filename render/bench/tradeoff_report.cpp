@@ -142,15 +142,13 @@ std::string tradeoff_csv(const std::vector<TradeoffRow>& rows) {
 }
 
 std::string tradeoff_summary(const std::vector<TradeoffRow>& rows, const std::string& machine,
-                             int reference_samples) {
+                             const std::string& truth, int reference_samples) {
   std::ostringstream md;
   md << "# The speed/accuracy map: summary\n\n"
      << "Written by `lucent bench tradeoff` from tradeoff.csv (read the README beside it for "
         "which technique to pick when). Machine: "
-     << machine
-     << ". Error: relative RMSE over the object's pixels against a converged CPU reference of "
-     << reference_samples
-     << " probes per pixel, same scene and model (sh: after the least-squares scale, since it "
+     << machine << ". Error: relative RMSE over the object's pixels against " << truth
+     << " (sh: after the least-squares scale, since it "
         "is right only up to one). Time to the image: from nothing to that image (setup, "
         "precomputation such as the hierarchy's links, every accumulated frame), GL context "
         "creation excluded; time per frame: the steady-state cost of one more frame (the "
@@ -162,8 +160,8 @@ std::string tradeoff_summary(const std::vector<TradeoffRow>& rows, const std::st
     // e^2 = s^2 / n + s^2 / N  ->  its noise s / sqrt(N) = e / sqrt(N / n + 1).
     for (const TradeoffRow& r : here) {
       int n = 0;
-      if (is(r, TechniqueId::kReference) && std::sscanf(r.setting.c_str(), "samples %d", &n) == 1 &&
-          n > 0) {
+      if (reference_samples > 0 && is(r, TechniqueId::kReference) &&
+          std::sscanf(r.setting.c_str(), "samples %d", &n) == 1 && n > 0) {
         md << "- reference at " << n << " probes: " << number(r.relative_rmse, 3)
            << " from the converged one, so the converged reference's own noise is about "
            << number(r.relative_rmse / std::sqrt(double(reference_samples) / n + 1), 2) << "\n";
@@ -203,11 +201,12 @@ std::string tradeoff_summary(const std::vector<TradeoffRow>& rows, const std::st
 }
 
 void write_tradeoff_report(const std::vector<TradeoffRow>& rows, const std::string& machine,
-                           int reference_samples, const std::filesystem::path& out_dir) {
+                           const std::string& truth, int reference_samples,
+                           const std::filesystem::path& out_dir) {
   std::filesystem::create_directories(out_dir);
   write_file_atomically(out_dir / "tradeoff.csv", tradeoff_csv(rows));
   write_file_atomically(out_dir / "tradeoff_summary.md",
-                        tradeoff_summary(rows, machine, reference_samples));
+                        tradeoff_summary(rows, machine, truth, reference_samples));
   const std::array<std::array<std::uint8_t, 3>, 4> colours{
       {{30, 70, 200}, {20, 150, 40}, {220, 120, 0}, {60, 60, 60}}};
   const std::array<imaging::Marker, 4> markers{imaging::Marker::kCircle, imaging::Marker::kSquare,
@@ -220,7 +219,7 @@ void write_tradeoff_report(const std::vector<TradeoffRow>& rows, const std::stri
                   (per_frame ? std::string("time per frame") : std::string("time to the image")) +
                   " (lines: each technique's Pareto front)";
     panel.x_label = per_frame ? "time per frame (ms)" : "time to the image (ms)";
-    panel.y_label = "relative RMSE vs converged reference";
+    panel.y_label = "relative RMSE vs the truth";
     panel.log_x = panel.log_y = true;
     for (std::size_t k = 0; k < std::size(kTechniques); ++k) {
       const TechniqueInfo& info = technique_info(kTechniques[k]);

@@ -21,15 +21,24 @@ enum class TradeoffSweep {
 };
 TradeoffSweep parse_tradeoff_sweep(const std::string& text);  ///< full | short | tiny
 
+/// What every image is held to: the path tracer (the medium itself: the error includes each
+/// model's) or the converged CPU reference of the same BSSRDF model (the pipeline's error alone).
+enum class TradeoffTruth { kPathtrace, kReference };
+TradeoffTruth parse_tradeoff_truth(const std::string& text);
+
 struct TradeoffBenchOptions {
   std::filesystem::path out_dir = "notebooks_data/bench";
-  /// MESH/MATERIAL/LIGHTING, LIGHTING one of directional, point, env (a procedural sky of
-  /// `env_lights` importance-sampled lights). The first scene gets the full sweep.
+  /// MESH/MATERIAL/LIGHTING[/SIZE_MM], LIGHTING one of directional, point, env (a procedural sky
+  /// of `env_lights` importance-sampled lights), SIZE_MM the object's size (default 100). The first
+  /// scene gets the full sweep. Every technique renders as the CLI does by default: the single
+  /// scattering and the angular factor on where it has them.
   std::vector<std::string> scenes = {"sphere/marble/directional", "sphere/potato/point",
                                      "sphere/skin1/env",          "sphere/ketchup/directional",
                                      "bunny/marble/point",        "dragon:3/skin1/env"};
   TradeoffSweep sweep = TradeoffSweep::kFull;
   int size = 64;                      ///< image, pixels square
+  TradeoffTruth truth = TradeoffTruth::kPathtrace;
+  int truth_samples = 2048;           ///< paths per pixel of the path-traced truth
   int reference_samples = 8192;       ///< probes per pixel of the converged reference
   int env_lights = 8;                 ///< lights standing for the environment map
   int threads = 0;                    ///< the reference's threads (0: all)
@@ -68,8 +77,10 @@ double maps_time_at_error(const std::vector<TradeoffRow>& maps_front, double err
 std::string tradeoff_csv(const std::vector<TradeoffRow>& rows);
 /// `reference_samples`: the converged reference's probes per pixel (its noise is estimated from
 /// the reference rows).
+/// `truth`: what the error is against, in words; `reference_samples` 0 when it is not the
+/// reference.
 std::string tradeoff_summary(const std::vector<TradeoffRow>& rows, const std::string& machine,
-                             int reference_samples);
+                             const std::string& truth, int reference_samples);
 
 /// Runs the sweep (progress lines to `log`), writes tradeoff.csv, tradeoff.png, tradeoff.svg and
 /// tradeoff_summary.md into out_dir (each atomically). Returns the rows.
