@@ -252,7 +252,8 @@ void write_tradeoff_report(const std::vector<TradeoffRow>& rows, const std::stri
     if (i == 0) figure.panels.push_back(panel_for(scenes[i], true));
   }
   figure.footer = {"Machine: " + machine +
-                   ". Subsurface term only, 100 mm objects; maps: frames accumulate along each "
+                   ". Subsurface term only, objects of 100 mm unless the scene gives a size; maps: "
+                   "frames accumulate along each "
                    "setting's points; the reference: independent runs at fewer probes."};
   figure.width = 1000;
   figure.height = 160 + 420 * int(figure.panels.size());

@@ -81,6 +81,11 @@ std::vector<BadCase> option_cases() {
       {"render_passes_zero", nullptr, ren + "--reference-passes 0", "--reference-passes"},
       {"render_single_scattering_foo", nullptr, ren + "--single-scattering foo",
        "--single-scattering"},
+      {"render_angular_foo", nullptr, ren + "--angular foo", "--angular"},
+      {"bench_truth_foo", nullptr, "bench tradeoff --truth foo --sweep tiny --out-dir {dir}",
+       "--truth"},
+      {"bench_scene_size_zero", nullptr,
+       "bench tradeoff --scenes sphere/marble/point/0 --sweep tiny --out-dir {dir}", "--scenes"},
       {"render_single_scattering_sh", nullptr,
        ren.substr(0, ren.find("--technique")) + "--technique sh --single-scattering on " +
            ren.substr(ren.find("--technique") + 22),

@@ -86,6 +86,30 @@ TEST(SingleScattering, QuadratureMatchesTheClosedFormOfASemiInfiniteMedium) {
   EXPECT_GT(worst_oblique, 0.0);  // not exact there: the test measures the quadrature
 }
 
+// Channels of close sigma_t (within 1.25: here 1.52, 1.48, 1.45 mm^-1, as potato's or marble's)
+// share one set of points drawn for the smallest, each weighted by e^(-(sigma_t - sigma_ref) s):
+// within 1% of the closed form lit and seen at up to 60 degrees (measured: printed).
+TEST(SingleScattering, SharedPointsOfCloseChannelsMatchTheClosedForm) {
+  double worst = 0;
+  for (const double eta : {1.0, 1.3}) {
+    materials::Material material = medium(0.02, 1.5, 0.5, eta);
+    material.sigma_a = {0.02, 0.03, 0.05};
+    material.sigma_s = materials::Rgb{1.5, 1.45, 1.4};
+    const detail::SingleMedium m = detail::SingleMedium::of(material);
+    for (const Angles a :
+         {Angles{0, 0, 0}, Angles{60, 0, 0}, Angles{60, 60, 180}, Angles{45, 30, 90}}) {
+      const Vector3d w_i = at_angle(a.light_deg), w_o = at_angle(a.view_deg, a.azimuth_deg);
+      const Vector3d got = twin_on_plane(m, w_i, w_o, detail::kSingleScatteringSteps);
+      for (int c = 0; c < 3; ++c) {
+        const double truth = testing_slab::single_scattering_truth(material, c, w_i, w_o);
+        worst = std::max(worst, std::abs(got[c] / truth - 1));
+      }
+    }
+  }
+  std::printf("shared points: worst %.2e of the closed form\n", worst);
+  EXPECT_LT(worst, 0.01);
+}
+
 // The path tracer's single scattering (Monte Carlo along the refracted view ray, the exact
 // refracted connection to the sun, written independently) at the centre of the wide box: the closed
 // form within 3 standard errors.

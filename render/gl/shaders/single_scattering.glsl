@@ -35,13 +35,17 @@ vec3 single_scattering_radiance(SingleMedium m, vec3 x_o, vec3 n_o, vec3 w_o, in
   vec3 t = -w_o / eta + (cos_o / eta - cos_to) * n_o;
   float leaving = fresnel_transmittance(cos_o, eta) / (eta * eta);
   bool is_point = light_position.w > 0.5;
-  for (int c = 0; c < 3; ++c) {
-    float sigma_t = m.sigma_t[c];
-    if (!(sigma_t > 0.0)) continue;
-    float sum = 0.0;
+  float lo = min(m.sigma_t.x, min(m.sigma_t.y, m.sigma_t.z));
+  float hi = max(m.sigma_t.x, max(m.sigma_t.y, m.sigma_t.z));
+  bool one_set = lo > 0.0 && hi <= 1.25 * lo;  // kShareRatio
+  for (int group = 0; group < (one_set ? 1 : 3); ++group) {
+    float sigma_ref = one_set ? lo : m.sigma_t[group];
+    if (!(sigma_ref > 0.0)) continue;
+    int first = one_set ? 0 : group, last = one_set ? 2 : group;
+    vec3 sum = vec3(0.0);
     for (int k = 0; k < steps; ++k) {
       float u = (float(k) + 0.5) / float(steps);
-      float s = -lucent_log1p(-u) / sigma_t;
+      float s = -lucent_log1p(-u) / sigma_ref;
       vec3 x = x_o + s * t;
       vec3 w = is_point ? normalize(light_position.xyz - x) : light_position.xyz;
       float distance_mm;
@@ -51,16 +55,20 @@ vec3 single_scattering_radiance(SingleMedium m, vec3 x_o, vec3 n_o, vec3 w_o, in
       if (!(cos_i > 0.0)) continue;
       float cos_ti = sqrt(max(0.0, 1.0 - (1.0 - cos_i * cos_i) / (eta * eta)));
       float s_in = distance_mm * cos_i / cos_ti;
-      float E = radiance[c];
+      float falloff = 1.0;
       if (is_point) {
         vec3 d = light_position.xyz - (x + distance_mm * w);
-        E /= max(dot(d, d), 1e-12);
+        falloff = 1.0 / max(dot(d, d), 1e-12);
       }
-      float E_in = E * fresnel_transmittance(cos_i, eta) * cos_i / cos_ti;
+      float T_in = fresnel_transmittance(cos_i, eta) * cos_i / cos_ti;
       vec3 d_in = -w / eta + (cos_i / eta - cos_ti) * n_i;
-      sum += m.sigma_s[c] * henyey_greenstein(m.g[c], -dot(d_in, t)) * E_in * exp(-sigma_t * s_in);
+      for (int c = first; c <= last; ++c) {
+        float sigma_t = m.sigma_t[c];
+        sum[c] += m.sigma_s[c] * henyey_greenstein(m.g[c], -dot(d_in, t)) * radiance[c] * falloff *
+                  T_in * exp(-sigma_t * s_in - (sigma_t - sigma_ref) * s);
+      }
     }
-    L[c] = leaving * sum / (float(steps) * sigma_t);
+    for (int c = first; c <= last; ++c) L[c] = leaving * sum[c] / (float(steps) * sigma_ref);
   }
   return L;
 }

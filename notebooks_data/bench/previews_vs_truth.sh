@@ -1,0 +1,53 @@
+#!/bin/bash
+# The previews against the path-traced truth (--technique pathtrace: the medium itself, no
+# diffusion model): spheres of 30 mm under a sun from the camera's side and one from behind, then
+# of 10 and 100 mm under the first (marble's truth at 100 mm is out of reach on a CPU), four
+# materials from high to low albedo at their own eta, and two at eta 1. 64 px, subsurface term only (--specular off), the truth at 512 paths per pixel
+# (~0.3% noise in the object's mean). Rows: the maps at light settings (K 8, N 16, W 128, 16
+# frames) as they render by default (single scattering and the angular factor on: "maps") and as
+# before them (both off: "mapsold"), the reference (the material's model, 512 probes: "ref") and
+# the hierarchical technique (dipole: "hier"). Writes CSV lines
+# (scene,material,eta,size_mm,light,technique,mean_R,mean_G,mean_B,relative_rmse) to stdout;
+# previews_vs_truth.csv holds a run.
+# Usage: previews_vs_truth.sh [LUCENT] [WORKDIR]   (about 45 min on 2 cores, mostly the truth)
+set -euo pipefail
+L=${1:-build/ci/cli/lucent}
+W=${2:-$(mktemp -d)}
+export MESA_SHADER_CACHE_DISABLE=true
+maps="--maps-frames 16 --maps-directions 8 --maps-samples 16 --maps-radiance-map 128 --maps-light-map 256"
+echo "scene,material,eta,size_mm,light,technique,mean_R,mean_G,mean_B,relative_rmse"
+# One scene: material, eta (own or 1.0), sphere size (mm), light (front or back).
+scene() {
+  local mat=$1 eta=$2 size=$3 lit=$4 m=$1 e
+  if [ "$eta" = 1.0 ]; then
+  m="$W/${mat}_eta1.json"
+  python3 -c "import json; d=json.load(open('materials/library/$mat.json')); d['ior']=1.0; json.dump(d, open('$m','w'))"
+  fi
+  e=$(python3 -c "import json; print(1.0 if '$eta'=='1.0' else json.load(open('materials/library/$mat.json'))['ior'])")
+  local name=${lit%%:*} dir=${lit#*:} tag common line rmse rgb t
+  name=${lit%%:*}; dir=${lit#*:}
+  tag=${mat}_${eta}_${size}_${name}
+  common="--material $m --mesh sphere --object-size-mm $size --size 64x64 --light directional:$dir:1,1,1 --specular off"
+  [ -f "$W/pt_$tag.exr" ] || "$L" render --technique pathtrace --pathtrace-samples-pixel 512 $common -o "$W/pt_$tag.exr" >/dev/null
+  "$L" render --technique maps $common $maps -o "$W/maps_$tag.exr" >/dev/null
+  "$L" render --technique maps $common $maps --single-scattering off --angular off -o "$W/mapsold_$tag.exr" >/dev/null
+  "$L" render --technique reference --reference-samples-pixel 512 $common -o "$W/ref_$tag.exr" >/dev/null
+  "$L" render --technique hierarchical --model dipole $common -o "$W/hier_$tag.exr" >/dev/null
+  for t in maps mapsold ref hier; do
+    line=$("$L" compare "$W/${t}_$tag.exr" "$W/pt_$tag.exr" | tail -1)
+    rmse=$(echo "$line" | sed -E 's/.*RMSE ([0-9.e+-]+).*/\1/')
+    rgb=$(echo "$line" | sed -E 's/.*R ([0-9.e+-]+) G ([0-9.e+-]+) B ([0-9.e+-]+).*/\1,\2,\3/')
+    echo "$tag,$mat,$e,$size,$name,$t,$rgb,$rmse"
+  done
+}
+# The materials at 30 mm under both suns (marble from behind: its truth takes over 10 min at 512
+# paths, left out), then the sizes under the front sun, then eta 1.
+for mat in potato skin1 marble ketchup; do
+  for lit in front:0.4,0.5,1 back:-1,0.3,-0.5; do
+    [ "$mat/$lit" = marble/back:-1,0.3,-0.5 ] || scene $mat own 30 $lit
+  done
+done
+for mat in potato skin1 ketchup; do
+  for size in 10 100; do scene $mat own $size front:0.4,0.5,1; done
+done
+for mat in potato skin1; do scene $mat 1.0 30 front:0.4,0.5,1; done
