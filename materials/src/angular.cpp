@@ -4,32 +4,10 @@
 #include <algorithm>
 #include <numbers>
 
+#include "lucent/materials/quadrature.h"
+
 namespace lucent::materials {
 namespace {
-
-// Gauss-Legendre nodes and weights on [0, 1] (Newton on P_n from the asymptotic guesses).
-void gauss_legendre(int n, std::vector<double>& x, std::vector<double>& w) {
-  x.resize(std::size_t(n));
-  w.resize(std::size_t(n));
-  for (int i = 0; i < n; ++i) {
-    double z = std::cos(std::numbers::pi * (i + 0.75) / (n + 0.5));
-    double dp = 1;
-    for (int it = 0; it < 100; ++it) {
-      double p0 = 1, p1 = z;
-      for (int k = 2; k <= n; ++k) {
-        const double p2 = ((2 * k - 1) * z * p1 - (k - 1) * p0) / k;
-        p0 = p1;
-        p1 = p2;
-      }
-      dp = n * (z * p1 - p0) / (z * z - 1);
-      const double dz = p1 / dp;
-      z -= dz;
-      if (std::abs(dz) < 1e-15) break;
-    }
-    x[std::size_t(i)] = 0.5 * (z + 1);
-    w[std::size_t(i)] = 1 / ((1 - z * z) * dp * dp);  // 2 / ((1 - z^2) P'^2), halved for [0, 1]
-  }
-}
 
 // cos of the refracted direction inside for an outside cosine (eta = n_inside / n_outside >= 1).
 double inside_cosine(double cos_outside, double eta) {
@@ -40,7 +18,7 @@ double inside_cosine(double cos_outside, double eta) {
 }  // namespace
 
 HFunction::HFunction(double omega) : omega_(std::clamp(omega, 0.0, 1.0)) {
-  gauss_legendre(48, mu_, weight_);
+  gauss_legendre(48, 0, 1, mu_, weight_);
   h_.assign(mu_.size(), 1.0);
   const double root = std::sqrt(1 - omega_);
   std::vector<double> next(h_.size());

@@ -73,12 +73,6 @@ constexpr int kSingleScatteringSteps = 8;
 /// Channels whose sigma_t are within this ratio share the quadrature's points.
 constexpr double kShareRatio = 1.25;
 
-/// Henyey-Greenstein density per steradian of turning by cos_theta.
-inline double henyey_greenstein(double g, double cos_theta) {
-  const double d = 1 + g * g - 2 * g * cos_theta;
-  return (1 - g * g) / (4 * std::numbers::pi * d * std::sqrt(d));
-}
-
 /// The single-scattering radiance (per channel) leaving x_o (outward normal n_o) toward the unit
 /// w_o lit by `light`; `entry(x, w)` -> LightEntry finds the light's entry point from x toward w.
 template <typename Entry>
@@ -122,7 +116,7 @@ Eigen::Vector3d single_scattering_radiance(const SingleMedium& m, const Eigen::V
       const Eigen::Vector3d d_in = -w / eta + (cos_i / eta - cos_ti) * e.normal;
       for (int c = first; c <= last; ++c) {
         const double sigma_t = m.sigma_t[std::size_t(c)];
-        const double phase = henyey_greenstein(m.g[std::size_t(c)], -d_in.dot(t));
+        const double phase = materials::henyey_greenstein(m.g[std::size_t(c)], -d_in.dot(t));
         // e^(-(sigma_t - sigma_ref) s): the points were drawn for sigma_ref.
         sum[c] += m.sigma_s[std::size_t(c)] * phase * light.radiance[c] * falloff * T_in *
                   std::exp(-sigma_t * s_in - (sigma_t - sigma_ref) * s);

@@ -77,8 +77,7 @@ struct Phase {
   double g = 0;
   double pdf(double cos_theta) const {
     if (std::abs(g) < 1e-4) return 1 / (4 * kPi);
-    const double d = 1 + g * g - 2 * g * cos_theta;
-    return (1 - g * g) / (4 * kPi * d * std::sqrt(d));
+    return materials::henyey_greenstein(g, cos_theta);
   }
   Vec3d sample(const Vec3d& direction, double xi1, double xi2) const;
 };

@@ -103,10 +103,10 @@ Vec3f specular_radiance(const Scene& scene, const RayScene& rays, const PixelHit
 class IrradianceCache;
 
 /// The angular factor of multiple scattering when the scene asks for it (Scene::angular) and the
-/// model is radial (the directional dipole has its own dependence on the incidence); else null.
+/// model takes it (materials::angular_factor_applies); else null.
 inline std::unique_ptr<materials::AngularFactor> angular_factor_for(const Scene& scene,
                                                                     DiffusionModel model) {
-  if (!scene.angular || model == DiffusionModel::kDirectionalDipole) return nullptr;
+  if (!scene.angular || !materials::angular_factor_applies(model)) return nullptr;
   return std::make_unique<materials::AngularFactor>(scene.material);
 }
 

@@ -109,9 +109,7 @@ inline double single_scattering_truth(const materials::Material& material, int c
     return Eigen::Vector3d(-w.x() / eta, -cos_t, -w.z() / eta);
   };
   const Eigen::Vector3d d_in = inside(w_i), d_out = -inside(w_o);
-  const double cos_theta = d_in.dot(d_out), g = m.g;
-  const double d = 1 + g * g - 2 * g * cos_theta;
-  const double phase = (1 - g * g) / (4 * std::numbers::pi * d * std::sqrt(d));
+  const double phase = materials::henyey_greenstein(m.g, d_in.dot(d_out));
   return materials::fresnel_transmittance(w_i.y(), eta) *
          materials::fresnel_transmittance(w_o.y(), eta) * w_i.y() * m.sigma_s * phase /
          (eta * eta * (m.sigma_a + m.sigma_s) * (-d_in.y() + d_out.y()));

@@ -40,6 +40,18 @@ class SlabTruthTest : public testing_gl::GlTest {
  protected:
 };
 
+// The radiance maps at the tiny settings these tests use: N 16 of M 256, W_s = W_l = map_size.
+RenderSettings tiny_maps(DiffusionModel model, int directions, int frames, int map_size) {
+  RenderSettings settings;
+  settings.model = model;
+  settings.directions = directions;
+  settings.samples = 16;
+  settings.disc_points = 256;
+  settings.frames = frames;
+  settings.radiance_map_size = settings.light_map_size = map_size;
+  return settings;
+}
+
 TEST(SlabClosedForm, QuadratureOfTheDipoleMatchesItsTotalDiffuseReflectance) {
   // The yardstick itself: over a face far wider than the tail, the quadrature of R_d is the
   // closed-form R_tot.
@@ -82,13 +94,7 @@ TEST_F(SlabTruthTest, RadianceMapsMatchTheClosedFormAtAnyTexelSize) {
   };
   for (const SlabCase& c : cases) {
     const testing_slab::SlabScene slab = testing_slab::make_slab_scene(c.material, 16);
-    RenderSettings settings;
-    settings.model = c.model;
-    settings.directions = 8;
-    settings.samples = 16;
-    settings.disc_points = 256;
-    settings.frames = 16;
-    settings.radiance_map_size = settings.light_map_size = c.map_size;
+    RenderSettings settings = tiny_maps(c.model, 8, 16, c.map_size);
     if (c.light_map_size > 0) settings.light_map_size = c.light_map_size;
     const ImageRgb image = render_radiance_maps(slab.scene, settings);
     for (int ch = 0; ch < 3; ++ch) {
@@ -199,13 +205,7 @@ TEST_F(SlabTruthTest, SwappingLightAndCameraKeepsThePowerReceived) {
                 materials::to_string(model).c_str(), ref_ab, ref_ba, 100 * (ref_ab / ref_ba - 1));
     EXPECT_NEAR(ref_ab / ref_ba, 1.0, 0.01) << materials::to_string(model);
     if (context_ == nullptr) continue;
-    RenderSettings settings;
-    settings.model = model;
-    settings.directions = 8;
-    settings.samples = 16;
-    settings.disc_points = 256;
-    settings.frames = 16;
-    settings.radiance_map_size = settings.light_map_size = 64;
+    RenderSettings settings = tiny_maps(model, 8, 16, 64);
     const double maps_ab = power_at_camera(render_radiance_maps(forward, settings), forward.camera);
     const double maps_ba = power_at_camera(render_radiance_maps(backward, settings), backward.camera);
     std::printf("reciprocity %s maps: %.6g vs %.6g (%+.3f%%)\n", materials::to_string(model).c_str(),
@@ -246,13 +246,7 @@ TEST_F(SlabTruthTest, RadianceMapsSingleScatteringMatchesTheClosedForm) {
     slab.scene.camera.eye = Vec3f(0, 25, 0) + 300.0f * w_o.cast<float>();
     slab.scene.camera.up = std::abs(w_o.z()) > 0.5 ? Vec3f(1, 0, 0) : Vec3f(0, 0, -1);
     slab.scene.camera.fov_y_deg = 1;
-    RenderSettings settings;
-    settings.model = DiffusionModel::kDipole;
-    settings.directions = 8;
-    settings.samples = 16;
-    settings.disc_points = 256;
-    settings.frames = 1;
-    settings.radiance_map_size = settings.light_map_size = 32;
+    RenderSettings settings = tiny_maps(DiffusionModel::kDipole, 8, 1, 32);
     slab.scene.single_scattering = true;
     const ImageRgb with = render_radiance_maps(slab.scene, settings);
     slab.scene.single_scattering = false;
@@ -282,13 +276,7 @@ TEST_F(SlabTruthTest, RadianceMapsAngularFactorIsTheCppOne) {
       Vec3f(0, 25, 0) + 300.0f * Vec3f(0, float(std::cos(b)), float(std::sin(b)));
   slab.scene.camera.up = Vec3f(1, 0, 0);
   slab.scene.camera.fov_y_deg = 1;
-  RenderSettings settings;
-  settings.model = DiffusionModel::kTabulated;
-  settings.directions = 4;
-  settings.samples = 16;
-  settings.disc_points = 256;
-  settings.frames = 1;
-  settings.radiance_map_size = settings.light_map_size = 32;
+  RenderSettings settings = tiny_maps(DiffusionModel::kTabulated, 4, 1, 32);
   slab.scene.angular = true;
   const ImageRgb with = render_radiance_maps(slab.scene, settings);
   slab.scene.angular = false;

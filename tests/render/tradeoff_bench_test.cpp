@@ -97,18 +97,24 @@ TEST(TradeoffReport, BadScenesAreRefusedBeforeAnyWork) {
   EXPECT_FALSE(fs::exists(o.out_dir / "tradeoff.csv"));
 }
 
+// A tiny sweep of one scene into a fresh folder named after `tag`.
+TradeoffBenchOptions tiny_sweep(const std::string& tag, const std::string& scene, int size) {
+  TradeoffBenchOptions o;
+  o.out_dir = fs::temp_directory_path() / ("lucent_tradeoff_" + tag + std::to_string(::getpid()));
+  fs::remove_all(o.out_dir);
+  o.scenes = {scene};
+  o.sweep = TradeoffSweep::kTiny;
+  o.size = size;
+  return o;
+}
+
 // The check: the CSV with every technique. One tiny scene (320 triangles, 32 px, a
 // reference of 512 probes): ~6 s on llvmpipe.
 TEST(TradeoffBench, TinySweepMeasuresEveryTechniqueAgainstTheReference) {
   setenv("MESA_SHADER_CACHE_DISABLE", "true", 0);
   std::string why_not;
   if (!GlContext::try_create_headless(&why_not)) GTEST_SKIP() << "no headless OpenGL: " << why_not;
-  TradeoffBenchOptions o;
-  o.out_dir = fs::temp_directory_path() / ("lucent_tradeoff_" + std::to_string(::getpid()));
-  fs::remove_all(o.out_dir);
-  o.scenes = {"sphere:2/marble/directional"};
-  o.sweep = TradeoffSweep::kTiny;
-  o.size = 32;
+  TradeoffBenchOptions o = tiny_sweep("", "sphere:2/marble/directional", 32);
   o.truth = TradeoffTruth::kReference;  // the bounds below are the pipelines' own error
   o.reference_samples = 512;
   std::ostringstream log;
@@ -157,12 +163,7 @@ TEST(TradeoffBench, TinySweepAgainstThePathTracedTruth) {
   setenv("MESA_SHADER_CACHE_DISABLE", "true", 0);
   std::string why_not;
   if (!GlContext::try_create_headless(&why_not)) GTEST_SKIP() << "no headless OpenGL: " << why_not;
-  TradeoffBenchOptions o;
-  o.out_dir = fs::temp_directory_path() / ("lucent_tradeoff_pt_" + std::to_string(::getpid()));
-  fs::remove_all(o.out_dir);
-  o.scenes = {"sphere:2/skin1/directional/20"};
-  o.sweep = TradeoffSweep::kTiny;
-  o.size = 24;
+  TradeoffBenchOptions o = tiny_sweep("pt_", "sphere:2/skin1/directional/20", 24);
   o.truth_samples = 256;
   std::ostringstream log;
   const std::vector<TradeoffRow> rows = run_tradeoff_bench(o, log);

@@ -379,7 +379,7 @@ void RadianceMapRenderer::Impl::upload_disc(int t, bool redraw) {
 
 void RadianceMapRenderer::Impl::upload_material() {
   gl::set_bssrdf_uniforms(radiance_program.id(), scene.material);
-  const bool angular = scene.angular && settings.model != DiffusionModel::kDirectionalDipole;
+  const bool angular = scene.angular && materials::angular_factor_applies(settings.model);
   gl::set_angular_uniforms(radiance_program.id(), scene.material, angular);
   gl::set_angular_uniforms(final_program.id(), scene.material, angular);
   gl::set_fur_coat_uniforms(radiance_program.id(), scene.fur_coat);

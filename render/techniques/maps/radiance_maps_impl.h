@@ -16,6 +16,7 @@
 #include "gl_frame.h"
 #include "gl_program.h"
 #include "lucent/core/error.h"
+#include "lucent/materials/angular.h"
 #include "lucent/render/environment.h"
 #include "lucent/render/gl_context.h"
 #include "lucent/render/radiance_maps.h"

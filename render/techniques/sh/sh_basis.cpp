@@ -3,36 +3,11 @@
 
 #include <Eigen/LU>
 
+#include "lucent/materials/quadrature.h"
+
 namespace lucent::render {
 
-namespace {
-
-// Gauss-Legendre nodes and weights on [a, b] (Newton on P_n from the Chebyshev guesses).
-void gauss_legendre(int n, double a, double b, std::vector<double>& x, std::vector<double>& w) {
-  x.assign(std::size_t(n), 0.0);
-  w.assign(std::size_t(n), 0.0);
-  for (int i = 0; i < n; ++i) {
-    double t = std::cos(std::numbers::pi * (i + 0.75) / (n + 0.5));
-    double dp = 1;
-    for (int iteration = 0; iteration < 100; ++iteration) {
-      double p0 = 1, p1 = t;
-      for (int k = 2; k <= n; ++k) {
-        const double p2 = ((2 * k - 1) * t * p1 - (k - 1) * p0) / k;
-        p0 = p1;
-        p1 = p2;
-      }
-      const double p = n == 0 ? 1 : p1, pm = p0;
-      dp = n * (t * p - pm) / (t * t - 1);
-      const double step = p / dp;
-      t -= step;
-      if (std::abs(step) < 1e-16) break;
-    }
-    x[std::size_t(i)] = 0.5 * (b - a) * t + 0.5 * (b + a);
-    w[std::size_t(i)] = (b - a) / ((1 - t * t) * dp * dp);
-  }
-}
-
-}  // namespace
+using materials::gauss_legendre;
 
 ShQuadrature sh_quadrature(int n) {
   ShQuadrature rule;

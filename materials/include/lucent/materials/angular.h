@@ -21,8 +21,15 @@
 #include <vector>
 
 #include "lucent/materials/material.h"
+#include "lucent/materials/profile_table.h"
 
 namespace lucent::materials {
+
+/// Whether the angular factor applies to `model`: the radial models (tabulated, dipole); the
+/// directional dipole has its own dependence on the incidence.
+inline bool angular_factor_applies(DiffusionModel model) {
+  return model != DiffusionModel::kDirectionalDipole;
+}
 
 /// Chandrasekhar's H-function of isotropic scattering with single-scattering albedo omega in
 /// [0, 1], from 1/H(mu) = sqrt(1 - omega) + (omega / 2) int_0^1 mu' H(mu') / (mu + mu') dmu' on 48

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -28,6 +29,13 @@ struct Medium {
 
   std::string to_string() const;
 };
+
+/// The Henyey-Greenstein phase function: density per steradian of turning by cos_theta, mean
+/// cosine g (|g| < 1).
+inline double henyey_greenstein(double g, double cos_theta) {
+  const double d = 1 + g * g - 2 * g * cos_theta;
+  return (1 - g * g) / (4 * std::numbers::pi * d * std::sqrt(d));
+}
 
 /// Every coefficient of docs/DESIGN.md §4 for one channel. Names follow the papers.
 template <typename T>
