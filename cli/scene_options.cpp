@@ -128,6 +128,12 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
                   "exit beyond Fresnel (Chandrasekhar's H-function of the reduced albedo) for the "
                   "radial models (tabulated, dipole) in the reference, maps and hierarchical")
       ->capture_default_str();
+  cmd->add_option("--geometry-factor", args->geometry_factor,
+                  "on or off: the multiple scattering's dependence on the object's shape between "
+                  "entry and exit (the dipole's flux through the exit surface relative to a "
+                  "plane's: curved surfaces, thin parts lit from behind) for the radial models "
+                  "(tabulated, dipole) in the reference, maps and hierarchical")
+      ->capture_default_str();
   cmd->add_option("--backdrop", args->backdrop,
                   "R,G,B: radiance of the background where there is no environment map "
                   "(default black)");
@@ -229,6 +235,9 @@ void check_options(SceneArguments& args, const render::TechniqueInfo& technique)
   if (args.angular != "on" && args.angular != "off") {
     throw Error("--angular: expected on or off, got '" + args.angular + "'");
   }
+  if (args.geometry_factor != "on" && args.geometry_factor != "off") {
+    throw Error("--geometry-factor: expected on or off, got '" + args.geometry_factor + "'");
+  }
   if (args.single_scattering == "on" && !technique.single_scattering) {
     throw Error("--single-scattering: the " + technique.name +
                 " technique has no single-scattering term yet; use --single-scattering off or auto");
@@ -321,6 +330,7 @@ SceneSetup build_scene(SceneArguments& args) {
   // Techniques without the term ignore it; the viewer's switch reaches those with it.
   scene.single_scattering = args.single_scattering != "off";
   scene.angular = args.angular == "on";
+  scene.geometry_factor = args.geometry_factor == "on";
   scene.backdrop = backdrop;
   if (args.fur_coat == "on")
     scene.fur_coat = render::fur::make_fur_coat(render::fur::over_mesh(o.fur));

@@ -36,6 +36,7 @@ struct SceneArguments {
   std::string specular = "on";
   std::string single_scattering = "auto";  ///< --single-scattering auto|on|off
   std::string angular = "on";              ///< --angular on|off
+  std::string geometry_factor = "on";      ///< --geometry-factor on|off
   std::string backdrop;                  ///< R,G,B radiance; empty: black
   std::vector<std::string> default_rig;  ///< set by build_scene: the lights used when none given
   /// Every technique's options, filled by their flag groups (technique_flags.h); --seed writes

@@ -102,6 +102,7 @@ Scene make_scene(const SceneSpec& spec, const std::string& mesh, const TradeoffB
   scene.specular = false;  // the subsurface term alone: the lobe is the same in every technique
   scene.single_scattering = true;  // as the CLI renders by default (techniques without it: none)
   scene.angular = true;
+  scene.geometry_factor = true;
   if (spec.lighting == "directional") {
     scene.lights = {parse_light("directional:1,0.5,0.5:1,1,1")};
   } else if (spec.lighting == "point") {
@@ -497,7 +498,8 @@ std::vector<TradeoffRow> run_tradeoff_bench(const TradeoffBenchOptions& options,
                 std::to_string(options.truth_samples) +
                 " paths per pixel: the medium itself, so the error includes each model's; its own "
                 "per-pixel noise, from its standard errors, taken out of every RMSE in "
-                "quadrature); every technique with its single scattering and angular factor "
+                "quadrature); every technique with its single scattering, angular and shape "
+                "factors "
                 "where it has them"
           : "a converged CPU reference of " + std::to_string(options.reference_samples) +
                 " probes per pixel, same scene and model";

@@ -2,6 +2,7 @@
 #include "gl_bssrdf.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -9,6 +10,7 @@
 #include "lucent/core/error.h"
 #include "lucent/materials/angular.h"
 #include "lucent/materials/fresnel.h"
+#include "lucent/materials/geometry_factor.h"
 #include "lucent/materials/radial_slices.h"
 #include "lucent/materials/tabulated.h"
 #include "lucent/materials/transport_table.h"
@@ -111,6 +113,22 @@ void set_angular_uniforms(GLuint program, const materials::Material& material, b
     for (int c = 0; c < 3; ++c)
       nodes[std::size_t(3 * i + c)] = float(factor.nodes(c)[std::size_t(i)]);
   glProgramUniform3fv(program, glGetUniformLocation(program, "u_angular_nodes"), n, nodes.data());
+}
+
+void set_geometry_factor_uniforms(GLuint program, const materials::Material& material, bool on) {
+  glProgramUniform1i(program, glGetUniformLocation(program, "u_geometry_factor"), on ? 1 : 0);
+  if (!on) return;
+  std::array<float, 12> channels{};
+  for (int c = 0; c < 3; ++c) {
+    const auto d = materials::derive_coefficients(material.medium(c));
+    const std::size_t k = std::size_t(4 * c);
+    channels[k] = float(d.sigma_tr);
+    channels[k + 1] = float(d.z_r);
+    channels[k + 2] = float(d.z_v);
+    channels[k + 3] = d.scatters() ? 1.0f : 0.0f;
+  }
+  glProgramUniform4fv(program, glGetUniformLocation(program, "u_geometry_channels"), 3,
+                      channels.data());
 }
 
 void set_fur_coat_uniforms(GLuint program, const std::optional<FurCoat>& coat) {

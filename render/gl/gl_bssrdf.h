@@ -61,4 +61,9 @@ void set_fur_coat_uniforms(GLuint program, const std::optional<FurCoat>& coat);
 /// factor of multiple scattering (materials/angular.h) when `on`, else off (a factor of 1).
 void set_angular_uniforms(GLuint program, const materials::Material& material, bool on);
 
+/// Sets `u_geometry_factor` and `u_geometry_channels` (geometry_factor.glsl) in `program`: the
+/// material's dipole coefficients for the shape's factor (materials/geometry_factor.h) when `on`,
+/// else off (a factor of 1).
+void set_geometry_factor_uniforms(GLuint program, const materials::Material& material, bool on);
+
 }  // namespace lucent::render::gl

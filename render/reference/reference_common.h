@@ -27,6 +27,7 @@
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/directional_dipole.h"
 #include "lucent/materials/fresnel.h"
+#include "lucent/materials/geometry_factor.h"
 #include "lucent/materials/tabulated.h"
 #include "lucent/render/reference_renderer.h"
 #include "lucent/render/scene.h"
@@ -39,8 +40,14 @@ namespace lucent::render::detail {
 
 class ChannelBssrdf {
  public:
-  ChannelBssrdf(const materials::Medium<double>& medium, DiffusionModel model)
-      : model_(model), dipole_(medium), ddipole_(medium) {
+  /// `geometry`: the radial models take the shape's factor (materials/geometry_factor.h).
+  ChannelBssrdf(const materials::Medium<double>& medium, DiffusionModel model,
+                bool geometry = false)
+      : model_(model),
+        dipole_(medium),
+        ddipole_(medium),
+        geometry_(derive_coefficients(medium)),
+        use_geometry_(geometry && materials::geometry_factor_applies(model)) {
     if (model == DiffusionModel::kTabulated) {
       profile_ = materials::cached_tabulated_profile(materials::default_transport_table(),
                                                      medium.g, medium.eta);
@@ -48,20 +55,22 @@ class ChannelBssrdf {
     }
   }
 
-  /// S_d per mm^2 per sr without Fresnel; n_i and w_i are ignored by the radial models (the
-  /// tabulated one's is TabulatedModel::S_d).
+  /// S_d per mm^2 per sr without Fresnel; w_i is ignored by the radial models (the tabulated
+  /// one's is TabulatedModel::S_d), n_i and n_o too unless they take the shape's factor.
   double operator()(const Vec3d& x_i, const Vec3d& n_i, const Vec3d& w_i, const Vec3d& x_o,
                     const Vec3d& n_o) const {
-    if (model_ == DiffusionModel::kDipole) return dipole_.S_d((x_o - x_i).norm());
-    if (model_ == DiffusionModel::kTabulated)
-      return tabulated_->S_d((x_o - x_i).norm());
-    return ddipole_.S_d(x_i, n_i, w_i, x_o, n_o);
+    if (model_ == DiffusionModel::kDirectionalDipole) return ddipole_.S_d(x_i, n_i, w_i, x_o, n_o);
+    const double r = (x_o - x_i).norm();
+    const double s_d = model_ == DiffusionModel::kDipole ? dipole_.S_d(r) : tabulated_->S_d(r);
+    return use_geometry_ && s_d > 0 ? s_d * geometry_(x_i, n_i, x_o, n_o) : s_d;
   }
 
  private:
   DiffusionModel model_;
   materials::StandardDipole<double> dipole_;
   materials::DirectionalDipole<double> ddipole_;
+  materials::GeometryFactor<double> geometry_;
+  bool use_geometry_;
   std::shared_ptr<const materials::TabulatedProfile> profile_;
   std::shared_ptr<const materials::TabulatedModel<double>> tabulated_;
 };

@@ -137,9 +137,10 @@ void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions
   const double box = (mesh.bounds_max() - mesh.bounds_min()).norm();
   const RadialProfileDensity density(scene.material, model, box);
   if (!density.valid()) return;  // nothing scatters: no subsurface light
-  const std::array<ChannelBssrdf, 3> bssrdf = {ChannelBssrdf(scene.material.medium(0), model),
-                                               ChannelBssrdf(scene.material.medium(1), model),
-                                               ChannelBssrdf(scene.material.medium(2), model)};
+  const bool g = scene.geometry_factor;
+  const std::array<ChannelBssrdf, 3> bssrdf = {ChannelBssrdf(scene.material.medium(0), model, g),
+                                               ChannelBssrdf(scene.material.medium(1), model, g),
+                                               ChannelBssrdf(scene.material.medium(2), model, g)};
   const bool per_light = model == DiffusionModel::kDirectionalDipole;
   const AreaLightSampling area_sampling = area_light_sampling(options, scene);
   const double R = density.r_max();

@@ -48,8 +48,9 @@ class ReferenceRun {
                                     : std::max(1, int(std::thread::hardware_concurrency()))),
         eta(scene.material.ior),
         media{scene.material.medium(0), scene.material.medium(1), scene.material.medium(2)},
-        bssrdf{ChannelBssrdf(media[0], model), ChannelBssrdf(media[1], model),
-               ChannelBssrdf(media[2], model)},
+        bssrdf{ChannelBssrdf(media[0], model, scene.geometry_factor),
+               ChannelBssrdf(media[1], model, scene.geometry_factor),
+               ChannelBssrdf(media[2], model, scene.geometry_factor)},
         environment(scene.environment
                         ? std::make_unique<EnvironmentMap>(load_environment(*scene.environment))
                         : nullptr),
@@ -391,6 +392,7 @@ void ReferenceRun::fill_stats() {
       {"seed", options.seed},
       {"single_scattering", single_term != nullptr},
       {"angular", angular != nullptr},
+      {"geometry_factor", scene.geometry_factor && materials::geometry_factor_applies(model)},
       {"single_samples_per_pass", single_term ? options.single_samples : 0},
       {"single_connection_failures", single_term ? single_term->connection_failures() : 0},
       {"cutoff_mm",

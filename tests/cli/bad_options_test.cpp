@@ -82,6 +82,7 @@ std::vector<BadCase> option_cases() {
       {"render_single_scattering_foo", nullptr, ren + "--single-scattering foo",
        "--single-scattering"},
       {"render_angular_foo", nullptr, ren + "--angular foo", "--angular"},
+      {"render_geometry_factor_foo", nullptr, ren + "--geometry-factor foo", "--geometry-factor"},
       {"bench_truth_foo", nullptr, "bench tradeoff --truth foo --sweep tiny --out-dir {dir}",
        "--truth"},
       {"bench_scene_size_zero", nullptr,

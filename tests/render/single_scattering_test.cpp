@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <utility>
 
 #include "lucent/materials/fresnel.h"
 #include "path_walk.h"
@@ -87,14 +88,17 @@ TEST(SingleScattering, QuadratureMatchesTheClosedFormOfASemiInfiniteMedium) {
 }
 
 // Channels of close sigma_t (within 1.25: here 1.52, 1.48, 1.45 mm^-1, as potato's or marble's)
-// share one set of points drawn for the smallest, each weighted by e^(-(sigma_t - sigma_ref) s):
-// within 1% of the closed form lit and seen at up to 60 degrees (measured: printed).
+// share one set of points drawn for the smallest, each weighted by e^(-(sigma_t - sigma_ref) s);
+// within 2 (1.52, 2.23, 2.95, as skin1's 0.77, 1.05, 1.49) they share 12: within 1% of the closed
+// form lit and seen at up to 60 degrees (measured: printed; 8 shared points were 1.8% at 2.95).
 TEST(SingleScattering, SharedPointsOfCloseChannelsMatchTheClosedForm) {
   double worst = 0;
-  for (const double eta : {1.0, 1.3}) {
+  const materials::Rgb close{1.5, 1.45, 1.4}, wider{1.5, 2.2, 2.9};
+  for (const auto& [eta, sigma_s] : {std::pair{1.0, close}, std::pair{1.3, close},
+                                     std::pair{1.0, wider}, std::pair{1.3, wider}}) {
     materials::Material material = medium(0.02, 1.5, 0.5, eta);
     material.sigma_a = {0.02, 0.03, 0.05};
-    material.sigma_s = materials::Rgb{1.5, 1.45, 1.4};
+    material.sigma_s = sigma_s;
     const detail::SingleMedium m = detail::SingleMedium::of(material);
     for (const Angles a :
          {Angles{0, 0, 0}, Angles{60, 0, 0}, Angles{60, 60, 180}, Angles{45, 30, 90}}) {

@@ -133,9 +133,13 @@ TEST(TradeoffBench, TinySweepMeasuresEveryTechniqueAgainstTheReference) {
     // noise (~1.5% at 512 probes) well inside them: the reference's noise at 64 probes is
     // sqrt(512 / 64 + 1) times that, ~4.5%; the maps' tiny setting is coarse (20% bound); the
     // hierarchical technique must meet the 10% on a lit sphere.
-    if (r.technique == "reference") EXPECT_LT(r.relative_rmse, 0.08);
-    if (r.technique == "maps") EXPECT_LT(r.relative_rmse, 0.2);
-    if (r.technique == "hierarchical") EXPECT_LT(r.relative_rmse, 0.1);
+    if (r.technique == "reference") {
+      EXPECT_LT(r.relative_rmse, 0.08);
+    } else if (r.technique == "maps") {
+      EXPECT_LT(r.relative_rmse, 0.2);
+    } else if (r.technique == "hierarchical") {
+      EXPECT_LT(r.relative_rmse, 0.1);
+    }
     if (r.technique == "sh") {
       EXPECT_GT(r.correlation, 0.5);  // the bound for sh (set for the bunny)
       EXPECT_LT(r.scaled_rmse, r.relative_rmse);
@@ -156,9 +160,11 @@ TEST(TradeoffBench, TinySweepMeasuresEveryTechniqueAgainstTheReference) {
 }  // namespace
 // Against the path-traced truth (the default): a 20 mm skin1 sphere (paths stay short), every
 // technique measured, the summary naming the truth. The maps and the reference carry their
-// model's error now (the dipole, 1.2-1.4 times too bright in green and blue here): measured
-// 0.23-0.29; bounded at 0.35 (a technique without its single scattering was 0.4-0.6 off such a
-// truth: notebooks_data/bench/previews_vs_truth.sh).
+// model's error now: the dipole is 1.3-1.6 times too bright in green and blue here, and the shape's
+// factor (materials/geometry_factor.h: +10-15% on a convex 20 mm sphere) adds to it: measured
+// 0.35-0.45 (0.23-0.29 without the factor); bounded at 0.5. Red, where the dipole is nearly right
+// (1.12-1.19 with the factor), is held to 1.0-1.3: without its single scattering a technique loses
+// a quarter of it (notebooks_data/bench/previews_vs_truth.sh).
 TEST(TradeoffBench, TinySweepAgainstThePathTracedTruth) {
   setenv("MESA_SHADER_CACHE_DISABLE", "true", 0);
   std::string why_not;
@@ -174,7 +180,11 @@ TEST(TradeoffBench, TinySweepAgainstThePathTracedTruth) {
     std::printf("%s %s %s: error %.3f, means %.3f %.3f %.3f\n", r.technique.c_str(),
                 r.model.c_str(), r.setting.c_str(), r.error(), r.mean_ratio[0], r.mean_ratio[1],
                 r.mean_ratio[2]);
-    if (r.technique == "reference" || r.technique == "maps") EXPECT_LT(r.relative_rmse, 0.35);
+    if (r.technique == "reference" || r.technique == "maps") {
+      EXPECT_LT(r.relative_rmse, 0.5) << r.technique;
+      EXPECT_GT(r.mean_ratio[0], 1.0) << r.technique;
+      EXPECT_LT(r.mean_ratio[0], 1.3) << r.technique;
+    }
   }
   EXPECT_EQ(techniques.size(), 4u);
   std::ifstream summary(o.out_dir / "tradeoff_summary.md");

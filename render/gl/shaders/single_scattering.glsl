@@ -37,14 +37,15 @@ vec3 single_scattering_radiance(SingleMedium m, vec3 x_o, vec3 n_o, vec3 w_o, in
   bool is_point = light_position.w > 0.5;
   float lo = min(m.sigma_t.x, min(m.sigma_t.y, m.sigma_t.z));
   float hi = max(m.sigma_t.x, max(m.sigma_t.y, m.sigma_t.z));
-  bool one_set = lo > 0.0 && hi <= 1.25 * lo;  // kShareRatio
+  bool one_set = lo > 0.0 && hi <= 2.0 * lo;  // kShareRatioWide
+  int n = one_set && hi > 1.25 * lo ? (3 * steps + 1) / 2 : steps;  // shared_steps
   for (int group = 0; group < (one_set ? 1 : 3); ++group) {
     float sigma_ref = one_set ? lo : m.sigma_t[group];
     if (!(sigma_ref > 0.0)) continue;
     int first = one_set ? 0 : group, last = one_set ? 2 : group;
     vec3 sum = vec3(0.0);
-    for (int k = 0; k < steps; ++k) {
-      float u = (float(k) + 0.5) / float(steps);
+    for (int k = 0; k < n; ++k) {
+      float u = (float(k) + 0.5) / float(n);
       float s = -lucent_log1p(-u) / sigma_ref;
       vec3 x = x_o + s * t;
       vec3 w = is_point ? normalize(light_position.xyz - x) : light_position.xyz;
@@ -68,7 +69,7 @@ vec3 single_scattering_radiance(SingleMedium m, vec3 x_o, vec3 n_o, vec3 w_o, in
                   T_in * exp(-sigma_t * s_in - (sigma_t - sigma_ref) * s);
       }
     }
-    for (int c = first; c <= last; ++c) L[c] = leaving * sum[c] / (float(steps) * sigma_ref);
+    for (int c = first; c <= last; ++c) L[c] = leaving * sum[c] / (float(n) * sigma_ref);
   }
   return L;
 }

@@ -301,6 +301,7 @@ ImageRgb render_hierarchical(const Scene& scene, const hierarchical::Options& op
                       {"edge_segments", s.edge_segments},
                       {"single_scattering", scene.single_scattering},
                       {"angular", scene.angular},
+                      {"geometry_factor", scene.geometry_factor},
                       {"timing", "one frame from scratch (hierarchy, links, solve), wall clock"},
                       {"options", options.to_string()}};
   }

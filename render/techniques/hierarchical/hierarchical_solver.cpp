@@ -16,6 +16,7 @@
 #include "lucent/core/error.h"
 #include "lucent/materials/angular.h"
 #include "lucent/materials/fresnel.h"
+#include "lucent/materials/geometry_factor.h"
 #include "lucent/materials/material.h"
 #include "reference_common.h"
 
@@ -152,6 +153,19 @@ struct Solver::Impl {
   }
 
   Rgb factor(int r, int e) {
+    Rgb F = planar_factor(r, e);
+    if (scene.geometry_factor) {  // the shape between the clusters (materials/geometry_factor.h)
+      const Cluster& R = h[r];
+      const Cluster& Em = h[e];
+      for (int ch = 0; ch < 3; ++ch) {
+        F[std::size_t(ch)] *= materials::GeometryFactor<double>(c[std::size_t(ch)])(
+            Em.midpoint, Em.normal, R.midpoint, R.normal);
+      }
+    }
+    return F;
+  }
+
+  Rgb planar_factor(int r, int e) {
     ++evaluations;
     const Cluster& R = h[r];
     const Cluster& Em = h[e];

@@ -382,6 +382,9 @@ void RadianceMapRenderer::Impl::upload_material() {
   const bool angular = scene.angular && materials::angular_factor_applies(settings.model);
   gl::set_angular_uniforms(radiance_program.id(), scene.material, angular);
   gl::set_angular_uniforms(final_program.id(), scene.material, angular);
+  gl::set_geometry_factor_uniforms(
+      radiance_program.id(), scene.material,
+      scene.geometry_factor && materials::geometry_factor_applies(settings.model));
   gl::set_fur_coat_uniforms(radiance_program.id(), scene.fur_coat);
   gl::set_fur_coat_uniforms(final_program.id(), scene.fur_coat);  // the specular lobe's light
   if (settings.model == DiffusionModel::kTabulated) {

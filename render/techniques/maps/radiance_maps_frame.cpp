@@ -211,6 +211,8 @@ ImageRgb render_radiance_maps(const Scene& scene, const RenderSettings& settings
         {"single_scattering", scene.single_scattering},
         {"single_scattering_steps", scene.single_scattering ? detail::kSingleScatteringSteps : 0},
         {"angular", scene.angular && materials::angular_factor_applies(settings.model)},
+        {"geometry_factor",
+         scene.geometry_factor && materials::geometry_factor_applies(settings.model)},
         {"sigma_star_per_mm", s.sigma_star_per_mm},
         {"disc_radius_mm", s.disc_radius_mm},
         {"used_disc_radius_mm", s.used_disc_radius_mm},

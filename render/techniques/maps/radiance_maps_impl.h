@@ -17,6 +17,7 @@
 #include "gl_program.h"
 #include "lucent/core/error.h"
 #include "lucent/materials/angular.h"
+#include "lucent/materials/geometry_factor.h"
 #include "lucent/render/environment.h"
 #include "lucent/render/gl_context.h"
 #include "lucent/render/radiance_maps.h"

@@ -87,6 +87,12 @@ struct Scene {
   /// one factor per side) in the reference, the maps and the hierarchical technique. The CLI's
   /// `--angular` turns it on by default; a Scene made in code has the radial BSSRDF alone.
   bool angular = false;
+  /// Give the radial BSSRDFs' multiple scattering its dependence on the object's shape between
+  /// the entry and exit points (materials/geometry_factor.h: the dipole's flux through the exit
+  /// surface, relative to a plane's: curvature, and thin parts lit from behind) in the reference,
+  /// the maps and the hierarchical technique. The CLI's `--geometry-factor` turns it on by
+  /// default; a Scene made in code has the planar profile alone.
+  bool geometry_factor = false;
   Vec3f backdrop{0, 0, 0};  ///< radiance of the background where no environment map is given
   /// A fur coat over the skin (fur_coat.h, an extension of Klotzli & Olano): the maps and the
   /// reference attenuate each light sample's transmitted irradiance by its T(n . w_i). `--fur-coat

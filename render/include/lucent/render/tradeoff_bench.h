@@ -31,7 +31,7 @@ struct TradeoffBenchOptions {
   /// MESH/MATERIAL/LIGHTING[/SIZE_MM], LIGHTING one of directional, point, env (a procedural sky
   /// of `env_lights` importance-sampled lights), SIZE_MM the object's size (default 100). The first
   /// scene gets the full sweep. Every technique renders as the CLI does by default: the single
-  /// scattering and the angular factor on where it has them.
+  /// scattering, the angular and the shape's factors on where it has them.
   std::vector<std::string> scenes = {"sphere/marble/directional", "sphere/potato/point",
                                      "sphere/skin1/env",          "sphere/ketchup/directional",
                                      "bunny/marble/point",        "dragon:3/skin1/env"};

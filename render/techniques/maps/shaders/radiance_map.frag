@@ -35,6 +35,7 @@ layout(early_fragment_tests) in;
 #include "fresnel.glsl"
 #include "fur_coat.glsl"
 #include "angular.glsl"
+#include "geometry_factor.glsl"
 #include "random.glsl"
 #include "bssrdf_ddipole.glsl"
 #include "bssrdf_dipole.glsl"
@@ -205,7 +206,8 @@ void main() {
 #endif
       E *= cos_i / max(dot(n_plane, w_i), 0.15);
       sum += sample_.z * fresnel_transmittance(cos_i, u_eta) * fur_coat(cos_i) * E *
-             bssrdf(x_i, n_i, w_i, x_o, n_o) * angular_factor(cos_i);
+             bssrdf(x_i, n_i, w_i, x_o, n_o) * angular_factor(cos_i) *
+             geometry_factor(x_i, n_i, x_o, n_o);
     }
   }
   vec4 previous = u_has_previous ? texelFetch(u_previous, ivec3(texel, g_layer), 0) : vec4(0.0);
