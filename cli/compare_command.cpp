@@ -91,6 +91,10 @@ void run_compare(const CompareArguments& args) {
                                 {"relative_rmse", d.relative_rmse},
                                 {"mean_ratio", d.mean_ratio},
                                 {"reference_mean", d.reference_mean}};
+    if (d.blocks > 0) {
+      doc["blocks"] = d.blocks;
+      doc["block_relative_rmse"] = d.block_relative_rmse;
+    }
     if (scaled) {
       doc["scaled"] = {{"scale", scaled->scale},
                        {"channel_scale", scaled->channel_scale},
@@ -112,8 +116,9 @@ void register_compare_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "compare",
       "How far a linear render (EXR) is from a reference render of the same size: relative RMSE "
-      "(RMSE over pixels and channels / the reference's mean) and per-channel mean ratios, over "
-      "the pixels where the reference is not black");
+      "(RMSE over pixels and channels / the reference's mean), the same over 4x4 blocks of pixels "
+      "(each block's mean; the blocks wholly on the object) and per-channel mean ratios, over the "
+      "pixels where the reference is not black");
   cmd->add_option("image", args->image, "the render to judge (.exr)")->required();
   cmd->add_option("reference", args->reference, "the reference (.exr), e.g. --technique reference")
       ->required();

@@ -10,7 +10,8 @@
 # render by default (single scattering, the angular and the shape's factors on: "maps"), without
 # the shape's factor ("mapsflat") and before all three ("mapsold"), the reference (the material's
 # model, 512 probes: "ref") and the hierarchical technique (dipole: "hier"). Writes CSV lines
-# (scene,material,eta,size_mm,light,technique,mean_R,mean_G,mean_B,relative_rmse) to stdout;
+# (scene,material,eta,size_mm,light,technique,mean_R,mean_G,mean_B,relative_rmse,block_rmse: per
+# pixel and over 4x4 blocks wholly on the object) to stdout;
 # previews_vs_truth.csv holds a run. Truths already in WORKDIR (pt_<scene>.exr) are reused.
 # Usage: previews_vs_truth.sh [LUCENT] [WORKDIR]   (about 60 min on 2 cores, mostly the truth)
 set -euo pipefail
@@ -25,7 +26,7 @@ w, h = 64, 32
 sys.stdout.buffer.write(b'#?RADIANCE\\nFORMAT=32-bit_rle_rgbe\\n\\n-Y %d +X %d\\n' % (h, w) + bytes([128, 128, 128, 129]) * (w * h))
 " > "$W/uniform_sky.hdr"
 maps="--maps-frames 16 --maps-directions 8 --maps-samples 16 --maps-radiance-map 128 --maps-light-map 256"
-echo "scene,material,eta,size_mm,light,technique,mean_R,mean_G,mean_B,relative_rmse"
+echo "scene,material,eta,size_mm,light,technique,mean_R,mean_G,mean_B,relative_rmse,block_rmse"
 # One scene: material, eta (own or 1.0), sphere size (mm), light (front or back).
 scene() {
   local mat=$1 eta=$2 size=$3 lit=$4 m=$1 e
@@ -41,16 +42,19 @@ scene() {
   [ "$dir" = sky ] && light="--env $W/uniform_sky.hdr:16"
   common="--material $m --mesh sphere --object-size-mm $size --size 64x64 $light --specular off"
   [ -f "$W/pt_$tag.exr" ] || "$L" render --technique pathtrace --pathtrace-samples-pixel $N $common -o "$W/pt_$tag.exr" >/dev/null
-  "$L" render --technique maps $common $maps -o "$W/maps_$tag.exr" >/dev/null
-  "$L" render --technique maps $common $maps --geometry-factor off -o "$W/mapsflat_$tag.exr" >/dev/null
-  "$L" render --technique maps $common $maps --single-scattering off --angular off --geometry-factor off -o "$W/mapsold_$tag.exr" >/dev/null
-  "$L" render --technique reference --reference-samples-pixel 512 $common -o "$W/ref_$tag.exr" >/dev/null
-  "$L" render --technique hierarchical --model dipole $common -o "$W/hier_$tag.exr" >/dev/null
+  # REUSE=1: keep the previews already rendered in WORKDIR (to recompute the comparisons only).
+  have() { [ -n "${REUSE:-}" ] && [ -f "$W/$1_$tag.exr" ]; }
+  have maps || "$L" render --technique maps $common $maps -o "$W/maps_$tag.exr" >/dev/null
+  have mapsflat || "$L" render --technique maps $common $maps --geometry-factor off -o "$W/mapsflat_$tag.exr" >/dev/null
+  have mapsold || "$L" render --technique maps $common $maps --single-scattering off --angular off --geometry-factor off -o "$W/mapsold_$tag.exr" >/dev/null
+  have ref || "$L" render --technique reference --reference-samples-pixel 512 $common -o "$W/ref_$tag.exr" >/dev/null
+  have hier || "$L" render --technique hierarchical --model dipole $common -o "$W/hier_$tag.exr" >/dev/null
   for t in maps mapsflat mapsold ref hier; do
     line=$("$L" compare "$W/${t}_$tag.exr" "$W/pt_$tag.exr" | tail -1)
-    rmse=$(echo "$line" | sed -E 's/.*RMSE ([0-9.e+-]+).*/\1/')
+    rmse=$(echo "$line" | sed -E 's/.*relative RMSE ([0-9.e+-]+) over [0-9]+ pixels.*/\1/')
+    block=$(echo "$line" | sed -nE 's/.*4x4 blocks: relative RMSE ([0-9.e+-]+).*/\1/p')
     rgb=$(echo "$line" | sed -E 's/.*R ([0-9.e+-]+) G ([0-9.e+-]+) B ([0-9.e+-]+).*/\1,\2,\3/')
-    echo "$tag,$mat,$e,$size,$name,$t,$rgb,$rmse"
+    echo "$tag,$mat,$e,$size,$name,$t,$rgb,$rmse,$block"
   done
 }
 # The materials at 30 mm under both suns (marble from behind: its truth takes over 10 min at 512

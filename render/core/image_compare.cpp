@@ -13,8 +13,57 @@ std::string ImageDifference::to_string() const {
   std::snprintf(text, sizeof text,
                 "relative RMSE %.4f over %zu pixels; mean ratio R %.4f G %.4f B %.4f", relative_rmse,
                 pixels, mean_ratio[0], mean_ratio[1], mean_ratio[2]);
-  return text;
+  std::string s = text;
+  if (blocks > 0) {
+    std::snprintf(text, sizeof text, "; 4x4 blocks: relative RMSE %.4f over %zu",
+                  block_relative_rmse, blocks);
+    s += text;
+  }
+  return s;
 }
+
+namespace {
+
+// ImageDifference::blocks and block_relative_rmse: 4x4 blocks wholly inside the mask.
+void compare_blocks(const ImageRgb& image, const ImageRgb& reference,
+                    const std::vector<std::uint8_t>& mask, ImageDifference& d) {
+  constexpr int kBlock = 4;
+  double squared = 0, sum_reference = 0;
+  for (int by = 0; by + kBlock <= image.height; by += kBlock) {
+    for (int bx = 0; bx + kBlock <= image.width; bx += kBlock) {
+      std::array<double, 3> a{}, b{};
+      bool inside = true;
+      for (int y = by; y < by + kBlock && inside; ++y) {
+        for (int x = bx; x < bx + kBlock; ++x) {
+          const std::size_t p = std::size_t(y) * std::size_t(image.width) + std::size_t(x);
+          if (!mask[p]) {
+            inside = false;
+            break;
+          }
+          for (int c = 0; c < 3; ++c) {
+            a[std::size_t(c)] += image.data[3 * p + std::size_t(c)];
+            b[std::size_t(c)] += reference.data[3 * p + std::size_t(c)];
+          }
+        }
+      }
+      if (!inside) continue;
+      ++d.blocks;
+      for (int c = 0; c < 3; ++c) {
+        const double difference = (a[std::size_t(c)] - b[std::size_t(c)]) / (kBlock * kBlock);
+        squared += difference * difference;
+        sum_reference += b[std::size_t(c)] / (kBlock * kBlock);
+      }
+    }
+  }
+  if (d.blocks == 0 || !(sum_reference > 0)) {
+    d.blocks = 0;
+    return;
+  }
+  const double n = 3.0 * double(d.blocks);
+  d.block_relative_rmse = std::sqrt(squared / n) / (sum_reference / n);
+}
+
+}  // namespace
 
 std::vector<std::uint8_t> nonzero_mask(const ImageRgb& reference) {
   std::vector<std::uint8_t> mask(std::size_t(reference.width) * reference.height, 0);
@@ -55,6 +104,7 @@ ImageDifference compare_images(const ImageRgb& image, const ImageRgb& reference,
                                        ? sum_image[std::size_t(c)] / sum_reference[std::size_t(c)]
                                        : (sum_image[std::size_t(c)] > 0 ? INFINITY : 1.0);
   }
+  compare_blocks(image, reference, mask, d);
   return d;
 }
 

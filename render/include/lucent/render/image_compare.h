@@ -17,6 +17,11 @@ struct ImageDifference {
   double relative_rmse = 0;         ///< RMSE over the pixels and channels / the reference's mean
   std::array<double, 3> mean_ratio{};  ///< per channel: mean of the image / mean of the reference
   double reference_mean = 0;        ///< all channels
+  /// The same over 4x4 blocks of pixels (each block's mean per channel) lying wholly inside the
+  /// mask, relative to the reference's mean over them: the error at a scale where a converged
+  /// image's per-pixel noise averages out (0 and no blocks when the mask holds none).
+  std::size_t blocks = 0;
+  double block_relative_rmse = 0;
   std::string to_string() const;
 };
 
