@@ -103,8 +103,19 @@ void set_bssrdf_uniforms(GLuint program, const materials::Material& material) {
   set("u_eta", float(material.ior));
 }
 
-void set_angular_uniforms(GLuint program, const materials::Material& material, bool on) {
+void set_angular_uniforms(GLuint program, const materials::Material& material, bool on, bool skew) {
   glProgramUniform1i(program, glGetUniformLocation(program, "u_angular"), on ? 1 : 0);
+  std::array<float, 3> mean_free_path{}, sigma_tr{};
+  for (int c = 0; c < 3; ++c) {
+    const auto d = materials::derive_coefficients(material.medium(c));
+    if (on && skew && d.sigma_t_reduced > 0) {
+      mean_free_path[std::size_t(c)] = float(1 / d.sigma_t_reduced);
+      sigma_tr[std::size_t(c)] = float(d.sigma_tr);
+    }
+  }
+  glProgramUniform3fv(program, glGetUniformLocation(program, "u_mean_free_path"), 1,
+                      mean_free_path.data());
+  glProgramUniform3fv(program, glGetUniformLocation(program, "u_sigma_tr"), 1, sigma_tr.data());
   if (!on) return;
   const materials::AngularFactor factor(material);
   constexpr int n = materials::AngularFactor::kNodes;

@@ -58,8 +58,11 @@ inline constexpr int kMaxFurCoatNodes = 32;  ///< LUCENT_MAX_FUR_COAT_NODES of f
 void set_fur_coat_uniforms(GLuint program, const std::optional<FurCoat>& coat);
 
 /// Sets `u_angular` and `u_angular_nodes` (angular.glsl) in `program`: the material's angular
-/// factor of multiple scattering (materials/angular.h) when `on`, else off (a factor of 1).
-void set_angular_uniforms(GLuint program, const materials::Material& material, bool on);
+/// factor of multiple scattering (materials/angular.h) when `on`, else off (a factor of 1); and
+/// `u_mean_free_path`, `u_sigma_tr`: the oblique skew's (materials::oblique_skew) when `on` and
+/// `skew`, else zero (a skew of 1).
+void set_angular_uniforms(GLuint program, const materials::Material& material, bool on,
+                          bool skew = true);
 
 /// Sets `u_geometry_factor` and `u_geometry_channels` (geometry_factor.glsl) in `program`: the
 /// material's dipole coefficients for the shape's factor (materials/geometry_factor.h) when `on`,

@@ -143,10 +143,11 @@ inline std::array<double, 3> gather(const ClusterTree& tree,
                                     const std::array<ChannelBssrdf, 3>& bssrdf,
                                     const std::array<double, 3>& r_cut, double cluster_ratio,
                                     bool needs_coherence, bool point_light, const Vec3f& x_o_f,
-                                    const Vec3f& n_o_f, GatherCounters& counters) {
+                                    const Vec3f& n_o_f, const Vec3f& w_o_f,
+                                    GatherCounters& counters) {
   std::array<double, 3> sum{0, 0, 0};
   if (tree.empty()) return sum;
-  const Vec3d x_o = x_o_f.cast<double>(), n_o = n_o_f.cast<double>();
+  const Vec3d x_o = x_o_f.cast<double>(), n_o = n_o_f.cast<double>(), w_o = w_o_f.cast<double>();
   const double r_cut_max = std::max({r_cut[0], r_cut[1], r_cut[2]});
   const auto& nodes = tree.nodes();
   const auto& records = tree.records();
@@ -165,7 +166,7 @@ inline std::array<double, 3> gather(const ClusterTree& tree,
         const Vec3d n_i = r.n.cast<double>(), w_i = r.w.cast<double>();
         for (int c = 0; c < 3; ++c) {
           if (r.E[c] > 0 && dist <= r_cut[c]) {
-            sum[c] += double(r.E[c]) * bssrdf[c](x_i, n_i, w_i, x_o, n_o);
+            sum[c] += double(r.E[c]) * bssrdf[c](x_i, n_i, w_i, x_o, n_o, w_o);
             ++counters.exact;
           }
         }
@@ -185,8 +186,8 @@ inline std::array<double, 3> gather(const ClusterTree& tree,
         double s = 0;
         for (int k = 0; k < 2; ++k) {
           const Vec3d a = node.axis[c][k].cast<double>();
-          s += bssrdf[c](centroid + a, n_i, w_i, x_o, n_o) +
-               bssrdf[c](centroid - a, n_i, w_i, x_o, n_o);
+          s += bssrdf[c](centroid + a, n_i, w_i, x_o, n_o, w_o) +
+               bssrdf[c](centroid - a, n_i, w_i, x_o, n_o, w_o);
         }
         sum[c] += double(node.E[c]) * 0.25 * s;
         counters.cluster += 4;

@@ -40,14 +40,24 @@ namespace lucent::render::detail {
 
 class ChannelBssrdf {
  public:
-  /// `geometry`: the radial models take the shape's factor (materials/geometry_factor.h).
+  /// `geometry`: the radial models take the shape's factor (materials/geometry_factor.h);
+  /// `skewed`: they take the oblique beams' skew (materials::oblique_skew) of the entry along w_i
+  /// and of the exit along w_o.
   ChannelBssrdf(const materials::Medium<double>& medium, DiffusionModel model,
-                bool geometry = false)
+                bool geometry = false, bool skewed = false)
       : model_(model),
         dipole_(medium),
         ddipole_(medium),
         geometry_(derive_coefficients(medium)),
-        use_geometry_(geometry && materials::geometry_factor_applies(model)) {
+        use_geometry_(geometry && materials::geometry_factor_applies(model)),
+        eta_(medium.eta) {
+    const auto coefficients = derive_coefficients(medium);
+    skewed_ =
+        skewed && materials::angular_factor_applies(model) && coefficients.sigma_t_reduced > 0;
+    if (skewed_) {
+      mean_free_path_ = 1 / coefficients.sigma_t_reduced;
+      sigma_tr_ = coefficients.sigma_tr;
+    }
     if (model == DiffusionModel::kTabulated) {
       profile_ = materials::cached_tabulated_profile(materials::default_transport_table(),
                                                      medium.g, medium.eta);
@@ -55,13 +65,22 @@ class ChannelBssrdf {
     }
   }
 
-  /// S_d per mm^2 per sr without Fresnel; w_i is ignored by the radial models (the tabulated
-  /// one's is TabulatedModel::S_d), n_i and n_o too unless they take the shape's factor.
+  /// Whether S_d depends on w_i (so that each light needs its own evaluation).
+  bool depends_on_light() const { return model_ == DiffusionModel::kDirectionalDipole || skewed_; }
+
+  /// S_d per mm^2 per sr without Fresnel; w_i (toward the light) and w_o (toward the eye; zero:
+  /// none) are ignored by the radial models unless skewed (the tabulated one's is
+  /// TabulatedModel::S_d), n_i and n_o too unless they take the shape's factor.
   double operator()(const Vec3d& x_i, const Vec3d& n_i, const Vec3d& w_i, const Vec3d& x_o,
-                    const Vec3d& n_o) const {
+                    const Vec3d& n_o, const Vec3d& w_o = Vec3d::Zero()) const {
     if (model_ == DiffusionModel::kDirectionalDipole) return ddipole_.S_d(x_i, n_i, w_i, x_o, n_o);
     const double r = (x_o - x_i).norm();
-    const double s_d = model_ == DiffusionModel::kDipole ? dipole_.S_d(r) : tabulated_->S_d(r);
+    double s_d = model_ == DiffusionModel::kDipole ? dipole_.S_d(r) : tabulated_->S_d(r);
+    if (skewed_) {
+      Vec3d shift = materials::oblique_displacement(w_i, n_i, eta_);
+      shift -= materials::oblique_displacement(w_o, n_o, eta_);
+      s_d *= materials::oblique_skew(Vec3d(x_o - x_i), shift, mean_free_path_, sigma_tr_);
+    }
     return use_geometry_ && s_d > 0 ? s_d * geometry_(x_i, n_i, x_o, n_o) : s_d;
   }
 
@@ -71,9 +90,22 @@ class ChannelBssrdf {
   materials::DirectionalDipole<double> ddipole_;
   materials::GeometryFactor<double> geometry_;
   bool use_geometry_;
+  double eta_;
+  bool skewed_ = false;                       ///< the oblique beam's skew (materials::oblique_skew)
+  double mean_free_path_ = 0, sigma_tr_ = 0;  ///< 1 / sigma_t' (mm), mm^-1
   std::shared_ptr<const materials::TabulatedProfile> profile_;
   std::shared_ptr<const materials::TabulatedModel<double>> tabulated_;
 };
+
+/// The scene's three channels' BSSRDFs for `model` (Scene::geometry_factor; the oblique skew
+/// with Scene::angular).
+inline std::array<ChannelBssrdf, 3> channel_bssrdfs(const Scene& scene, DiffusionModel model) {
+  const auto channel = [&](int c) {
+    return ChannelBssrdf(scene.material.medium(c), model, scene.geometry_factor,
+                         scene.angular && scene.oblique_skew);
+  };
+  return {channel(0), channel(1), channel(2)};
+}
 
 /// The direction w from x toward a light, the falloff 1 / distance^2 of a point light (1 for a
 /// directional one) and the distance (infinite for a directional light); false at the light.

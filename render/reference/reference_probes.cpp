@@ -61,8 +61,8 @@ std::array<double, 3> incidence_factor(const materials::AngularFactor* angular, 
 }
 
 void add_hit(const ProbeShading& ps, unsigned tri, const Vec3f& x_f, const Vec3f& g_f,
-             const Vec3f& n_f, const Vec3d& x_o, const Vec3d& n_o, double pdf, std::uint64_t key,
-             int n, std::array<double, 3>& sum) {
+             const Vec3f& n_f, const Vec3d& x_o, const Vec3d& n_o, const Vec3d& w_o, double pdf,
+             std::uint64_t key, int n, std::array<double, 3>& sum) {
   const Scene& scene = ps.scene;
   const ReferenceOptions& options = ps.options;
   const RayScene& rays = ps.rays;
@@ -75,7 +75,7 @@ void add_hit(const ProbeShading& ps, unsigned tri, const Vec3f& x_f, const Vec3f
   const Vec3d x_i = x_f.cast<double>(), n_i = n_f.cast<double>();
   std::array<double, 3> radial{0, 0, 0};
   if (!per_light) {
-    for (int c = 0; c < 3; ++c) radial[c] = bssrdf[c](x_i, n_i, n_i, x_o, n_o);
+    for (int c = 0; c < 3; ++c) radial[c] = bssrdf[c](x_i, n_i, n_i, x_o, n_o, w_o);
   }
   if (cache) {
     Vec3f w_cache;
@@ -83,7 +83,7 @@ void add_hit(const ProbeShading& ps, unsigned tri, const Vec3f& x_f, const Vec3f
     const Vec3d w_i = w_cache.cast<double>();
     const std::array<double, 3> k = incidence_factor(ps.angular, n_i.dot(w_i));
     for (int c = 0; c < 3; ++c) {
-      const double s_d = per_light ? bssrdf[c](x_i, n_i, w_i, x_o, n_o) : radial[c];
+      const double s_d = per_light ? bssrdf[c](x_i, n_i, w_i, x_o, n_o, w_o) : radial[c];
       sum[c] += E[std::size_t(c)] / pdf * s_d * k[c];
     }
   }
@@ -99,7 +99,7 @@ void add_hit(const ProbeShading& ps, unsigned tri, const Vec3f& x_f, const Vec3f
       const double factor = a.transmitted / pdf;
       const std::array<double, 3> k = incidence_factor(ps.angular, n_i.dot(w_i));
       for (int c = 0; c < 3; ++c) {
-        const double s_d = per_light ? bssrdf[c](x_i, n_i, w_i, x_o, n_o) : radial[c];
+        const double s_d = per_light ? bssrdf[c](x_i, n_i, w_i, x_o, n_o, w_o) : radial[c];
         sum[c] += factor * light.radiance[c] * s_d * k[c];
       }
       continue;
@@ -118,7 +118,7 @@ void add_hit(const ProbeShading& ps, unsigned tri, const Vec3f& x_f, const Vec3f
     const Vec3d w_i = w.cast<double>();
     const std::array<double, 3> k = incidence_factor(ps.angular, cos_i);
     for (int c = 0; c < 3; ++c) {
-      const double s_d = per_light ? bssrdf[c](x_i, n_i, w_i, x_o, n_o) : radial[c];
+      const double s_d = per_light ? bssrdf[c](x_i, n_i, w_i, x_o, n_o, w_o) : radial[c];
       sum[c] += factor * light.radiance[c] * s_d * k[c];
     }
   }
@@ -137,11 +137,8 @@ void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions
   const double box = (mesh.bounds_max() - mesh.bounds_min()).norm();
   const RadialProfileDensity density(scene.material, model, box);
   if (!density.valid()) return;  // nothing scatters: no subsurface light
-  const bool g = scene.geometry_factor;
-  const std::array<ChannelBssrdf, 3> bssrdf = {ChannelBssrdf(scene.material.medium(0), model, g),
-                                               ChannelBssrdf(scene.material.medium(1), model, g),
-                                               ChannelBssrdf(scene.material.medium(2), model, g)};
-  const bool per_light = model == DiffusionModel::kDirectionalDipole;
+  const std::array<ChannelBssrdf, 3> bssrdf = channel_bssrdfs(scene, model);
+  const bool per_light = bssrdf[0].depends_on_light();
   const AreaLightSampling area_sampling = area_light_sampling(options, scene);
   const double R = density.r_max();
   const float eps = 1e-4f * std::max(mesh.bounding_radius(), 1e-6f);
@@ -158,7 +155,8 @@ void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions
         std::uint64_t local_hits = 0;
         for (std::size_t i = begin; i < end; ++i) {
           const PixelHit& hit = hits[object_pixels[i]];
-          const Vec3d x_o = hit.x_o.cast<double>(), n_o = hit.n_o.cast<double>();
+          const Vec3d x_o = hit.x_o.cast<double>(), n_o = hit.n_o.cast<double>(),
+                      w_o = hit.w_o.cast<double>();
           Vec3d t_o, b_o;
           basis(n_o, t_o, b_o);
           const std::array<Vec3d, 3> axes = {n_o, t_o, b_o};
@@ -234,7 +232,7 @@ void probe_pass(const Scene& scene, DiffusionModel model, const ReferenceOptions
               pdf *= survival;
               ++local_hits;
 
-              add_hit(shading, tri, x_f, g_f, n_f, x_o, n_o, pdf, key, n, sum);
+              add_hit(shading, tri, x_f, g_f, n_f, x_o, n_o, w_o, pdf, key, n, sum);
             }
           }
           for (int c = 0; c < 3; ++c) accumulated[i][c] += sum[c] / S;

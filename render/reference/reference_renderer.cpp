@@ -48,9 +48,7 @@ class ReferenceRun {
                                     : std::max(1, int(std::thread::hardware_concurrency()))),
         eta(scene.material.ior),
         media{scene.material.medium(0), scene.material.medium(1), scene.material.medium(2)},
-        bssrdf{ChannelBssrdf(media[0], model, scene.geometry_factor),
-               ChannelBssrdf(media[1], model, scene.geometry_factor),
-               ChannelBssrdf(media[2], model, scene.geometry_factor)},
+        bssrdf(channel_bssrdfs(scene, model)),
         environment(scene.environment
                         ? std::make_unique<EnvironmentMap>(load_environment(*scene.environment))
                         : nullptr),
@@ -196,7 +194,7 @@ void ReferenceRun::trace_primary_rays() {
 void ReferenceRun::prepare_lights() {
   // Light groups: the standard dipole does not depend on the light's direction, so all lights
   // share one record per sample; the directional dipole needs one record set per light.
-  per_light = model == DiffusionModel::kDirectionalDipole;
+  per_light = bssrdf[0].depends_on_light();
   groups = per_light ? scene.lights.size() : (scene.lights.empty() ? 0 : 1);
   if (options.irradiance_cache &&
       std::any_of(scene.lights.begin(), scene.lights.end(),
@@ -316,7 +314,7 @@ void ReferenceRun::area_samples(int pass, std::vector<std::array<double, 3>>& ac
           for (std::size_t i = begin; i < end; ++i) {
             const PixelHit& hit = hits[object_pixels[i]];
             const auto s = gather(tree, bssrdf, r_cut, options.cluster_ratio, per_light,
-                                  point_light, hit.x_o, hit.n_o, counters);
+                                  point_light, hit.x_o, hit.n_o, hit.w_o, counters);
             for (int c = 0; c < 3; ++c) accumulated[i][c] += s[c];
           }
           exact += counters.exact;

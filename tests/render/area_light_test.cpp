@@ -29,6 +29,7 @@
 #include "area_light.h"
 #include "gl_api.h"
 #include "gl_fixture.h"
+#include "gl_kernel.h"
 #include "gl_program.h"
 #include "lucent/materials/fresnel.h"
 #include "lucent/materials/profile_table.h"
@@ -129,19 +130,8 @@ TEST_F(AreaLightGlTest, GlslFormFactorMatchesTheCpp) {
   }
   const gl::Program program = gl::Program::from_source(
       GL_COMPUTE_SHADER, "form_factor_twin.comp", kKernel, {"STRIDE " + std::to_string(kStride)});
-  gl::Buffer in = gl::create_buffer(), out = gl::create_buffer();
-  glNamedBufferStorage(in.id(), GLsizeiptr(input.size() * sizeof(float)), input.data(), 0);
-  glNamedBufferStorage(out.id(), GLsizeiptr(configs.size() * kOutputs * sizeof(float)), nullptr,
-                       GL_MAP_READ_BIT);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, in.id());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, out.id());
-  program.use();
-  glUniform1i(program.location("u_count"), GLint(configs.size()));
-  glDispatchCompute(GLuint((configs.size() + 63) / 64), 1, 1);
-  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  std::vector<float> result(configs.size() * kOutputs);
-  glGetNamedBufferSubData(out.id(), 0, GLsizeiptr(result.size() * sizeof(float)), result.data());
-  gl::check_errors("form factor twin");
+  const std::vector<float> result =
+      testing_gl::run_kernel(program, input, configs.size(), kOutputs, "form factor twin");
 
   // F relative to itself where it matters (|F| >= 1e-3, a light that delivers anything); the
   // vector relative to the contour's total angle sum_i angle_i / 2 pi everywhere: a polygon seen

@@ -31,9 +31,12 @@ lucent_add_test(area_light_test
 lucent_add_test(geometry_factor_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/geometry_factor_test.cpp
   LIBS lucent::render lucent::materials OpenGL::OpenGL)
+lucent_add_test(oblique_skew_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/oblique_skew_test.cpp
+  LIBS lucent::render lucent::materials OpenGL::OpenGL)
 # White-box: both include private headers of render/ (gl_program.h, gl_bssrdf.h,
 # radiance_maps_sampling.h).
-foreach(t glsl_twin_test geometry_factor_test radiance_maps_test sh_renderer_test area_light_test fur_glsl_twin_test
+foreach(t glsl_twin_test geometry_factor_test oblique_skew_test radiance_maps_test sh_renderer_test area_light_test fur_glsl_twin_test
           fur_renderer_test)
   target_include_directories(${t} PRIVATE ${LUCENT_RENDER_PRIVATE_DIRS})
 endforeach()

@@ -17,6 +17,8 @@
 
 #include "gl_api.h"
 #include "gl_bssrdf.h"
+#include "gl_fixture.h"
+#include "gl_kernel.h"
 #include "gl_program.h"
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/directional_dipole.h"
@@ -26,7 +28,6 @@
 #include "lucent/materials/tabulated.h"
 #include "lucent/materials/transport_table.h"
 #include "lucent/render/gl_context.h"
-#include "gl_fixture.h"
 
 namespace lucent::render {
 namespace {
@@ -271,20 +272,8 @@ class GlslTwinTest : public testing_gl::GlTest {
     }
     const gl::Program program = gl::Program::from_source(
         GL_COMPUTE_SHADER, "glsl_twin_test.comp", kKernel, {"STRIDE " + std::to_string(kStride)});
-    gl::Buffer in = gl::create_buffer(), out = gl::create_buffer();
-    glNamedBufferStorage(in.id(), GLsizeiptr(input.size() * sizeof(float)), input.data(), 0);
-    glNamedBufferStorage(out.id(), GLsizeiptr(configs.size() * kOutputs * sizeof(float)), nullptr,
-                         GL_MAP_READ_BIT);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, in.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, out.id());
-    program.use();
-    glUniform1i(program.location("u_count"), GLint(configs.size()));
-    glDispatchCompute(GLuint((configs.size() + 63) / 64), 1, 1);
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    std::vector<float> result(configs.size() * kOutputs);
-    glGetNamedBufferSubData(out.id(), 0, GLsizeiptr(result.size() * sizeof(float)), result.data());
-    gl::check_errors("glsl_twin_test kernel");
-    return result;
+    return testing_gl::run_kernel(program, input, configs.size(), kOutputs,
+                                  "glsl_twin_test kernel");
   }
 
 };

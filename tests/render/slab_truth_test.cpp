@@ -266,7 +266,9 @@ TEST_F(SlabTruthTest, RadianceMapsSingleScatteringMatchesTheClosedForm) {
 // The GLSL angular factor (angular.glsl: the gathered light times k(cos_i) in radiance_map.frag,
 // the subsurface radiance times k(cos_o) in final.frag) against the C++ one (materials/angular.h):
 // on the slab lit at 60 degrees and seen at 45, the image with the factor over the image without it
-// is k(cos 60) k(cos 45) per channel (float nodes, single-precision sums: within 0.2%).
+// is k(cos 60) k(cos 45) per channel (float nodes, single-precision sums: within 0.2%). The oblique
+// skew is left off: it keeps the plane's total only on average over the disc's rotations (one
+// frame of 8 samples here moves the image 2-3%).
 TEST_F(SlabTruthTest, RadianceMapsAngularFactorIsTheCppOne) {
   if (context_ == nullptr) GTEST_SKIP() << "no headless OpenGL: " << why_not_;
   testing_slab::SlabScene slab = testing_slab::make_slab_scene("skin1", 8);
@@ -278,6 +280,7 @@ TEST_F(SlabTruthTest, RadianceMapsAngularFactorIsTheCppOne) {
   slab.scene.camera.fov_y_deg = 1;
   RenderSettings settings = tiny_maps(DiffusionModel::kTabulated, 4, 1, 32);
   slab.scene.angular = true;
+  slab.scene.oblique_skew = false;
   const ImageRgb with = render_radiance_maps(slab.scene, settings);
   slab.scene.angular = false;
   const ImageRgb without = render_radiance_maps(slab.scene, settings);

@@ -162,9 +162,10 @@ TEST(TradeoffBench, TinySweepMeasuresEveryTechniqueAgainstTheReference) {
 // technique measured, the summary naming the truth. The maps and the reference carry their
 // model's error now: the dipole is 1.3-1.6 times too bright in green and blue here, and the shape's
 // factor (materials/geometry_factor.h: +10-15% on a convex 20 mm sphere) adds to it: measured
-// 0.35-0.45 (0.23-0.29 without the factor); bounded at 0.5. Red, where the dipole is nearly right
-// (1.12-1.19 with the factor), is held to 1.0-1.3: without its single scattering a technique loses
-// a quarter of it (notebooks_data/bench/previews_vs_truth.sh).
+// 0.24-0.35 (the oblique skew, materials/angular.h, takes 5-15% back); bounded at 0.5. Red, where
+// the dipole is nearly right (1.00-1.02 with the factor and the skew; 1.12-1.19 with the factor
+// alone), is held to 0.9-1.15: without its single scattering a technique loses a quarter of it
+// (notebooks_data/bench/previews_vs_truth.sh).
 TEST(TradeoffBench, TinySweepAgainstThePathTracedTruth) {
   setenv("MESA_SHADER_CACHE_DISABLE", "true", 0);
   std::string why_not;
@@ -182,8 +183,8 @@ TEST(TradeoffBench, TinySweepAgainstThePathTracedTruth) {
                 r.mean_ratio[2]);
     if (r.technique == "reference" || r.technique == "maps") {
       EXPECT_LT(r.relative_rmse, 0.5) << r.technique;
-      EXPECT_GT(r.mean_ratio[0], 1.0) << r.technique;
-      EXPECT_LT(r.mean_ratio[0], 1.3) << r.technique;
+      EXPECT_GT(r.mean_ratio[0], 0.9) << r.technique;
+      EXPECT_LT(r.mean_ratio[0], 1.15) << r.technique;
     }
   }
   EXPECT_EQ(techniques.size(), 4u);

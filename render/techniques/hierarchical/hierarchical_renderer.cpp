@@ -143,7 +143,7 @@ void HierarchicalRenderer::setup(const Scene& scene, const hierarchical::Options
   m.fit_bounds();
   m.upload_lights();
   glProgramUniform1f(m.program.id(), m.program.location("u_eta"), float(scene.material.ior));
-  gl::set_angular_uniforms(m.program.id(), scene.material, scene.angular);
+  gl::set_angular_uniforms(m.program.id(), scene.material, scene.angular, false);
   gl::check_errors("hierarchical setup");
 }
 
@@ -174,7 +174,7 @@ void HierarchicalRenderer::set_material(const materials::Material& material) {
   m.solver->set_material(material);
   m.single_valid = false;
   glProgramUniform1f(m.program.id(), m.program.location("u_eta"), float(material.ior));
-  gl::set_angular_uniforms(m.program.id(), material, m.scene.angular);
+  gl::set_angular_uniforms(m.program.id(), material, m.scene.angular, false);
 }
 
 void HierarchicalRenderer::set_geometry(const std::vector<Vec3f>& positions,

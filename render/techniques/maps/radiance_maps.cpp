@@ -380,8 +380,8 @@ void RadianceMapRenderer::Impl::upload_disc(int t, bool redraw) {
 void RadianceMapRenderer::Impl::upload_material() {
   gl::set_bssrdf_uniforms(radiance_program.id(), scene.material);
   const bool angular = scene.angular && materials::angular_factor_applies(settings.model);
-  gl::set_angular_uniforms(radiance_program.id(), scene.material, angular);
-  gl::set_angular_uniforms(final_program.id(), scene.material, angular);
+  gl::set_angular_uniforms(radiance_program.id(), scene.material, angular, scene.oblique_skew);
+  gl::set_angular_uniforms(final_program.id(), scene.material, angular, scene.oblique_skew);
   gl::set_geometry_factor_uniforms(
       radiance_program.id(), scene.material,
       scene.geometry_factor && materials::geometry_factor_applies(settings.model));

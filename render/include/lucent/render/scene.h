@@ -86,7 +86,11 @@ struct Scene {
   /// of incidence and exit (materials/angular.h: Chandrasekhar's H-function of the reduced albedo,
   /// one factor per side) in the reference, the maps and the hierarchical technique. The CLI's
   /// `--angular` turns it on by default; a Scene made in code has the radial BSSRDF alone.
+  /// With it, the reference and the maps also lean the profile toward each oblique beam's
+  /// refracted direction, at entry and (by reciprocity) exit (materials::oblique_skew) unless
+  /// `oblique_skew` is off (for measuring its share; the CLI's `--angular` sets both).
   bool angular = false;
+  bool oblique_skew = true;
   /// Give the radial BSSRDFs' multiple scattering its dependence on the object's shape between
   /// the entry and exit points (materials/geometry_factor.h: the dipole's flux through the exit
   /// surface, relative to a plane's: curvature, and thin parts lit from behind) in the reference,

@@ -144,9 +144,27 @@ vec3 specular_lights(vec3 x_o, vec3 n_o, vec3 w_o) {
   return sum;
 }
 
+// The gathered radiance of layer k at the exit point displaced, per channel, along the view's
+// oblique beam (by reciprocity with the entry's, angular.glsl): each channel read at its own point
+// (x_s + shift u_mean_free_path[c]); where that falls off the layer's map, x_o's own value.
+vec3 displaced_exit(int k, vec3 x_s, vec3 shift, vec3 value) {
+  for (int c = 0; c < 3; ++c) {
+    if (!(u_mean_free_path[c] > 0.0)) continue;
+    vec4 clip = u_layer_view_proj[k] * vec4(x_s + u_mean_free_path[c] * shift, 1.0);
+    vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
+    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) continue;
+    vec4 r = textureLod(u_radiance, vec3(uv, float(k)), u_mip_level);
+    if (r.a > 0.0) value[c] = r[c] / r.a;
+  }
+  return value;
+}
+
 void main() {
   vec3 x_o = f_position;
   vec3 n_o = normalize(f_normal);
+  vec3 w_o = normalize(u_eye - x_o);
+  vec3 exit_shift = oblique_displacement(w_o, n_o, u_eta);
+  bool displaced = any(greaterThan(u_mean_free_path, vec3(0.0)));
   vec3 sum = vec3(0.0);
   float seen = 0.0;
   for (int k = 0; k < u_layer_count; ++k) {
@@ -167,11 +185,12 @@ void main() {
     // spreads one texel over texel / cos_k of surface (and of the surfaces beside it), so its
     // value is the least accurate; equal weights let one grazing layer of K 8 at W_s 32 take
     // 19% off a flat slab.
-    sum += visible * cos_k * r.rgb / r.a;
+    vec3 value = r.rgb / r.a;
+    if (displaced) value = displaced_exit(k, x_s, exit_shift, value);
+    sum += visible * cos_k * value;
     seen += visible * cos_k;
   }
   vec3 L_ss = seen > 0.0 ? sum / seen : vec3(0.0);
-  vec3 w_o = normalize(u_eye - x_o);
   float F_r = fresnel_reflectance(dot(n_o, w_o), u_eta);
   vec3 L = (1.0 - F_r) * angular_factor(dot(n_o, w_o)) * L_ss;
   // The mirror direction's light crosses a fur coat too (cos_i = cos_o there; T = 1 without one).

@@ -92,16 +92,20 @@ void basis(vec3 n, out vec3 b1, out vec3 b2) {
   b2 = vec3(b, s + n.y * n.y * a, -n.y);
 }
 
+// S_d per channel; the radial models take the oblique beam's skew (angular.glsl; 1 when off).
 vec3 bssrdf(vec3 x_i, vec3 n_i, vec3 w_i, vec3 x_o, vec3 n_o) {
-#if defined(LUCENT_MODEL_DIPOLE)
-  return dipole_S_d_rgb(u_dipole, distance(x_o, x_i));
-#elif defined(LUCENT_MODEL_TABULATED)
+#if defined(LUCENT_MODEL_DDIPOLE)
+  return ddipole_S_d_rgb(u_ddipole, x_i, n_i, w_i, x_o, n_o);
+#else
   float r = distance(x_o, x_i);
+  vec3 skew = oblique_skew(x_o - x_i, oblique_displacement(w_i, n_i, u_eta));
+#if defined(LUCENT_MODEL_DIPOLE)
+  return dipole_S_d_rgb(u_dipole, r) * skew;
+#else
   return vec3(tabulated_S_d(u_tabulated_rows, u_tabulated[0], r),
               tabulated_S_d(u_tabulated_rows, u_tabulated[1], r),
-              tabulated_S_d(u_tabulated_rows, u_tabulated[2], r));
-#else
-  return ddipole_S_d_rgb(u_ddipole, x_i, n_i, w_i, x_o, n_o);
+              tabulated_S_d(u_tabulated_rows, u_tabulated[2], r)) * skew;
+#endif
 #endif
 }
 
