@@ -233,7 +233,9 @@ TEST(Tabulate, ExpectedEscapesNearBlackMatchTheSimulator) {
                               table.slices[0].se_code[0][std::size_t(k * o.grid.rho_bins() + j)]));
     }
     // At 10^5 photons escape tallies would give 40-120% there (sqrt(10) x the figure above).
-    if (k == 3) EXPECT_LT(worst_se, 0.08) << "alpha' " << alpha;
+    if (k == 3) {
+      EXPECT_LT(worst_se, 0.08) << "alpha' " << alpha;
+    }
     // Reference bins of more than ~100 escapes only (10 standard errors): at g 0.9 near black
     // the escapes far out are so rare that a bin's mean is skewed low with an SE to match (at
     // rho 2, alpha' 0.002: 4.7e-9 +- 0.9e-9 from ~30 escapes against the table's 3.1e-8, where
