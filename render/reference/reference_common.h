@@ -76,12 +76,13 @@ class ChannelBssrdf {
     if (model_ == DiffusionModel::kDirectionalDipole) return ddipole_.S_d(x_i, n_i, w_i, x_o, n_o);
     const double r = (x_o - x_i).norm();
     double s_d = model_ == DiffusionModel::kDipole ? dipole_.S_d(r) : tabulated_->S_d(r);
-    if (skewed_) {
-      Vec3d shift = materials::oblique_displacement(w_i, n_i, eta_);
-      shift -= materials::oblique_displacement(w_o, n_o, eta_);
-      s_d *= materials::oblique_skew(Vec3d(x_o - x_i), shift, mean_free_path_, sigma_tr_);
-    }
-    return use_geometry_ && s_d > 0 ? s_d * geometry_(x_i, n_i, x_o, n_o) : s_d;
+    if (!skewed_) return use_geometry_ && s_d > 0 ? s_d * geometry_(x_i, n_i, x_o, n_o) : s_d;
+    // The beams' refracted directions (tangential parts) skew the profile and, with the shape's
+    // factor, place its sources.
+    const Vec3d d_i = materials::oblique_displacement(w_i, n_i, eta_);
+    const Vec3d d_o = materials::oblique_displacement(w_o, n_o, eta_);
+    s_d *= materials::oblique_skew(Vec3d(x_o - x_i), Vec3d(d_i - d_o), mean_free_path_, sigma_tr_);
+    return use_geometry_ && s_d > 0 ? s_d * geometry_(x_i, n_i, d_i, x_o, n_o, d_o) : s_d;
   }
 
  private:

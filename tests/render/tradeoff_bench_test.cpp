@@ -161,11 +161,13 @@ TEST(TradeoffBench, TinySweepMeasuresEveryTechniqueAgainstTheReference) {
 // Against the path-traced truth (the default): a 20 mm skin1 sphere (paths stay short), every
 // technique measured, the summary naming the truth. The maps and the reference carry their
 // model's error now: the dipole is 1.3-1.6 times too bright in green and blue here, and the shape's
-// factor (materials/geometry_factor.h: +10-15% on a convex 20 mm sphere) adds to it: measured
-// 0.24-0.35 (the oblique skew, materials/angular.h, takes 5-15% back); bounded at 0.5. Red, where
-// the dipole is nearly right (1.00-1.02 with the factor and the skew; 1.12-1.19 with the factor
-// alone), is held to 0.9-1.15: without its single scattering a technique loses a quarter of it
-// (notebooks_data/bench/previews_vs_truth.sh).
+// factor (materials/geometry_factor.h: the osculating sphere, +10-30% within a few mean free paths
+// on a convex 20 mm sphere, as Monte Carlo has it) adds to it: measured 0.38-0.51 (the tiny maps'
+// first frame the most; the oblique skew, materials/angular.h, takes 5-15% back); bounded at 0.6.
+// Red, where the dipole is nearly right on a plane, is held to 0.9-1.25: measured 1.15-1.19 with
+// the factor and the skew (the tabulated model's reference is 0.97-1.02 on a 30 mm skin1: the rest
+// is the dipole's own excess in red); without its single scattering a technique loses a quarter of
+// it (notebooks_data/bench/previews_vs_truth.sh).
 TEST(TradeoffBench, TinySweepAgainstThePathTracedTruth) {
   setenv("MESA_SHADER_CACHE_DISABLE", "true", 0);
   std::string why_not;
@@ -182,9 +184,9 @@ TEST(TradeoffBench, TinySweepAgainstThePathTracedTruth) {
                 r.model.c_str(), r.setting.c_str(), r.error(), r.mean_ratio[0], r.mean_ratio[1],
                 r.mean_ratio[2]);
     if (r.technique == "reference" || r.technique == "maps") {
-      EXPECT_LT(r.relative_rmse, 0.5) << r.technique;
+      EXPECT_LT(r.relative_rmse, 0.6) << r.technique;
       EXPECT_GT(r.mean_ratio[0], 0.9) << r.technique;
-      EXPECT_LT(r.mean_ratio[0], 1.15) << r.technique;
+      EXPECT_LT(r.mean_ratio[0], 1.25) << r.technique;
     }
   }
   EXPECT_EQ(techniques.size(), 4u);

@@ -1,9 +1,11 @@
 // lucent GLSL 1: twin of materials/include/lucent/materials/geometry_factor.h (GeometryFactor): the
 // factor per channel by which the object's shape between the entry point (x_i, n_i) and the exit
-// point (x_o, n_o) changes a radial profile's multiple scattering (the dipole's flux through the
-// exit surface relative to a plane's; 1 on a plane). u_geometry_channels[c] = (sigma_tr, z_r, z_v,
-// 1 where the channel scatters), set by gl::set_geometry_factor_uniforms; 1 when
-// u_geometry_factor is off. tests/render/glsl_twin_test.cpp holds it against the C++.
+// point (x_o, n_o) changes a radial profile's multiple scattering: the flux of each beam's
+// diffusion sources (four along its refracted direction, each with its Kelvin image) through the
+// osculating sphere over a plane's at the same chord (1 on a plane; reciprocal).
+// u_geometry_channels[c] = (sigma_tr, z_r, z_v, 1 where the channel scatters), set by
+// gl::set_geometry_factor_uniforms; 1 when u_geometry_factor is off.
+// tests/render/geometry_factor_test.cpp holds it against the C++.
 #ifndef LUCENT_GEOMETRY_FACTOR_GLSL
 #define LUCENT_GEOMETRY_FACTOR_GLSL
 
@@ -11,6 +13,8 @@ uniform bool u_geometry_factor;
 uniform vec4 u_geometry_channels[3];
 
 const float kGeometryFactorMax = 64.0;
+const float kBeamDepths[4] = float[4](0.3225476896, 1.7457611012, 4.5366202969, 9.3950709123);
+const float kBeamDepthWeights[4] = float[4](0.6031541043, 0.3574186924, 0.0388879085, 0.0005392947);
 
 // (1 + s) e^(s0 - s) / d^3 with s = sigma_tr d, per channel.
 vec3 geometry_term(vec3 sigma_tr, vec3 d2, vec3 s0) {
@@ -19,50 +23,70 @@ vec3 geometry_term(vec3 sigma_tr, vec3 d2, vec3 s0) {
   return (1.0 + s) * exp(s0 - s) / (d2 * d);
 }
 
-// g from x_i to x_o, per channel (channels that do not scatter are masked by the caller).
-vec3 geometry_one_way(vec3 x_i, vec3 n_i, vec3 x_o, vec3 n_o) {
-  vec3 sigma_tr = vec3(u_geometry_channels[0].x, u_geometry_channels[1].x, u_geometry_channels[2].x);
-  vec3 z_r = vec3(u_geometry_channels[0].y, u_geometry_channels[1].y, u_geometry_channels[2].y);
-  vec3 z_v = vec3(u_geometry_channels[0].z, u_geometry_channels[1].z, u_geometry_channels[2].z);
-  vec3 x = x_o - x_i;
-  float r2 = dot(x, x);
-  vec3 s0 = sigma_tr * sqrt(r2);
-  vec3 f_r = geometry_term(sigma_tr, r2 + z_r * z_r, s0);
-  vec3 f_v = geometry_term(sigma_tr, r2 + z_v * z_v, s0);
-  vec3 planar = z_r * f_r + z_v * f_v;
-  float along = dot(x, n_o);
-  float x_n = dot(n_i, x);
-  vec3 n_star = n_i - (x_n / max(r2, 1e-30)) * x;
-  float len = length(n_star);
-  n_star = len > 1e-6 ? n_star / len : n_i;
-  vec3 tangent =
-      clamp(dot(n_star, n_o) + along * (f_r - f_v) / planar, vec3(0.0), vec3(kGeometryFactorMax));
-  float cos_io = dot(n_i, n_o);
-  float w = clamp(-cos_io, 0.0, 1.0);
-  vec3 g = tangent;
-  if (w > 0.0) {
-    // The sources at x_i -/+ z n_i seen from x_o and from 2 z_b further out along n_o.
-    vec3 z_b = 0.5 * (z_v - z_r);
-    vec3 a2 = r2 + 2.0 * z_r * x_n + z_r * z_r, a_n = along + z_r * cos_io;
-    vec3 b2 = r2 - 2.0 * z_v * x_n + z_v * z_v, b_n = along - z_v * cos_io;
-    vec3 flux = geometry_term(sigma_tr, a2, s0) * a_n - geometry_term(sigma_tr, b2, s0) * b_n +
-                geometry_term(sigma_tr, a2 + 4.0 * z_b * (a_n + z_b), s0) * (a_n + 2.0 * z_b) -
-                geometry_term(sigma_tr, b2 + 4.0 * z_b * (b_n + z_b), s0) * (b_n + 2.0 * z_b);
-    g = (1.0 - w) * tangent + w * clamp(flux / planar, vec3(0.0), vec3(kGeometryFactorMax));
+// One way, per channel: from the entry (origin, normal n, beam d: the refracted direction's
+// tangential part) to the exit x away, on the sphere of curvature inv_a (GeometryFactor::one_way).
+vec3 geometry_one_way(vec3 x, vec3 n, vec3 d, float inv_a_raw, vec3 sigma_tr, vec3 z_r, vec3 z_b) {
+  vec3 t = x - dot(x, n) * n;
+  if (!(dot(t, t) > 1e-20 * dot(x, x))) t = d - dot(d, n) * n;
+  if (!(dot(t, t) > 1e-30))
+    t = abs(n.x) < 0.9 ? cross(n, vec3(1.0, 0.0, 0.0)) : cross(n, vec3(0.0, 1.0, 0.0));
+  t = normalize(t);
+  vec3 b = cross(n, t);
+  float w_t = dot(d, t), w_b = dot(d, b);
+  float cos_t = sqrt(max(1.0 - w_t * w_t - w_b * w_b, 0.0));
+  float r = length(x);
+  vec3 inv_a = clamp(vec3(inv_a_raw), -0.5 / z_b, 1.0 / z_r);
+  vec3 half_sin = clamp(0.5 * r * inv_a, vec3(-1.0), vec3(1.0));
+  vec3 half_cos = sqrt(1.0 - half_sin * half_sin);
+  vec3 sin_g = 2.0 * half_sin * half_cos, cos_g = 1.0 - 2.0 * half_sin * half_sin;
+  vec3 x_t = r * half_cos, x_n = -r * half_sin;
+  vec3 reach =
+      mix(vec3(3.0e38), 0.9 * cos_t / max(inv_a, vec3(1e-30)), greaterThan(inv_a, vec3(0.0)));
+  vec3 s0 = sigma_tr * r;
+  vec3 lift = 1.0 + z_b * inv_a;
+  vec3 sphere = vec3(0.0), plane = vec3(0.0);
+  for (int k = 0; k < 4; ++k) {
+    vec3 s = min(kBeamDepths[k] * z_r, reach);
+    vec3 u_t = s * w_t, u_b = s * w_b, u_n = -s * cos_t;
+    vec3 lateral = (r - u_t) * (r - u_t) + u_b * u_b;
+    vec3 above = 2.0 * z_b - u_n;
+    plane += kBeamDepthWeights[k] * (-u_n * geometry_term(sigma_tr, lateral + u_n * u_n, s0) +
+                                     above * geometry_term(sigma_tr, lateral + above * above, s0));
+    vec3 den = 1.0 + 2.0 * u_n * inv_a + s * s * inv_a * inv_a;
+    vec3 rho = lift * lift / den;
+    vec3 i_t = rho * u_t, i_b = rho * u_b;
+    vec3 i_n = rho * u_n + (2.0 * z_b + z_b * z_b * inv_a - 2.0 * u_n - s * s * inv_a) / den;
+    vec3 e_t = x_t - u_t, e_n = x_n - u_n, f_t = x_t - i_t, f_n = x_n - i_n;
+    sphere += kBeamDepthWeights[k] *
+              (geometry_term(sigma_tr, e_t * e_t + u_b * u_b + e_n * e_n, s0) *
+                   (e_t * sin_g + e_n * cos_g) -
+               lift / sqrt(den) * geometry_term(sigma_tr, f_t * f_t + i_b * i_b + f_n * f_n, s0) *
+                   (f_t * sin_g + f_n * cos_g));
   }
-  // At x_o = x_i, or where a channel's planar term underflows: 1.
-  bvec3 defined = bvec3(r2 > 1e-12 * z_r.x * z_r.x && planar.x > 0.0,
-                        r2 > 1e-12 * z_r.y * z_r.y && planar.y > 0.0,
-                        r2 > 1e-12 * z_r.z * z_r.z && planar.z > 0.0);
-  return mix(vec3(1.0), g, defined);
+  vec3 g = clamp(sphere / plane, vec3(0.0), vec3(kGeometryFactorMax));
+  return mix(vec3(1.0), g, bvec3(inv_a.x != 0.0 && plane.x > 0.0, inv_a.y != 0.0 && plane.y > 0.0,
+                                 inv_a.z != 0.0 && plane.z > 0.0));
 }
 
-vec3 geometry_factor(vec3 x_i, vec3 n_i, vec3 x_o, vec3 n_o) {
+// G for a beam entering at x_i (normal n_i) with refracted tangential part d_i and light leaving at
+// x_o (n_o) toward a view whose reversed ray's is d_o (0: normal).
+vec3 geometry_factor(vec3 x_i, vec3 n_i, vec3 d_i, vec3 x_o, vec3 n_o, vec3 d_o) {
   if (!u_geometry_factor) return vec3(1.0);
-  vec3 g = sqrt(geometry_one_way(x_i, n_i, x_o, n_o) * geometry_one_way(x_o, n_o, x_i, n_i));
-  bvec3 scatters = bvec3(u_geometry_channels[0].w > 0.5, u_geometry_channels[1].w > 0.5,
-                         u_geometry_channels[2].w > 0.5);
-  return mix(vec3(1.0), g, scatters);
+  vec3 sigma_tr =
+      vec3(u_geometry_channels[0].x, u_geometry_channels[1].x, u_geometry_channels[2].x);
+  vec3 z_r = vec3(u_geometry_channels[0].y, u_geometry_channels[1].y, u_geometry_channels[2].y);
+  vec3 z_v = vec3(u_geometry_channels[0].z, u_geometry_channels[1].z, u_geometry_channels[2].z);
+  vec3 z_b = 0.5 * (z_v - z_r);
+  vec3 x = x_o - x_i;
+  float r2 = dot(x, x);
+  float inv_a = dot(x, n_o - n_i) / max(r2, 1e-30);
+  vec3 g = sqrt(geometry_one_way(x, n_i, d_i, inv_a, sigma_tr, z_r, z_b) *
+                geometry_one_way(-x, n_o, d_o, inv_a, sigma_tr, z_r, z_b));
+  // Coincident points, or a channel that does not scatter: 1.
+  bvec3 defined = bvec3(r2 > 1e-12 * z_r.x * z_r.x && u_geometry_channels[0].w > 0.5,
+                        r2 > 1e-12 * z_r.y * z_r.y && u_geometry_channels[1].w > 0.5,
+                        r2 > 1e-12 * z_r.z * z_r.z && u_geometry_channels[2].w > 0.5);
+  return mix(vec3(1.0), g, defined);
 }
 
 #endif
