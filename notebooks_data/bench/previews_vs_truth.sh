@@ -4,16 +4,17 @@
 # and to the side ("back": the camera sees part of the lit side) and one from straight behind
 # ("behind": it sees only light that crossed the sphere), then of 10 and 100 mm under the first
 # (marble's truth at 100 mm is out of reach on a CPU), four materials from high to low albedo at
-# their own eta, two at eta 1, and under a uniform white sky ("sky", 16 lights). 64 px, subsurface
-# term only (--specular off), the truth at TRUTH_SAMPLES paths per pixel (default 512: ~0.3% noise
-# in the object's mean). Rows: the maps at light settings (K 8, N 16, W 128, 16 frames) as they
+# their own eta, two at eta 1, and under a uniform white sky ("sky", 16 lights); then the issue's
+# other targets (skies at 15 and 100 mm and over ketchup, the sun at eta 1 at 15 mm and on
+# ketchup). 64 px, subsurface term only (--specular off), the truth at TRUTH_SAMPLES paths per
+# pixel (default 512: ~0.3% noise in the object's mean). Rows: the maps at light settings (K 8, N 16, W 128, 16 frames) as they
 # render by default (single scattering, the angular and the shape's factors on: "maps"), without
 # the shape's factor ("mapsflat") and before all three ("mapsold"), the reference (the material's
 # model, 512 probes: "ref") and the hierarchical technique (dipole: "hier"). Writes CSV lines
 # (scene,material,eta,size_mm,light,technique,mean_R,mean_G,mean_B,relative_rmse,block_rmse: per
 # pixel and over 4x4 blocks wholly on the object) to stdout;
 # previews_vs_truth.csv holds a run. Truths already in WORKDIR (pt_<scene>.exr) are reused.
-# Usage: previews_vs_truth.sh [LUCENT] [WORKDIR]   (about 60 min on 2 cores, mostly the truth)
+# Usage: previews_vs_truth.sh [LUCENT] [WORKDIR]   (about 90 min on 2 cores, mostly the truth)
 set -euo pipefail
 L=${1:-build/ci/cli/lucent}
 W=${2:-$(mktemp -d)}
@@ -72,3 +73,10 @@ for mat in potato skin1 ketchup; do scene $mat own 30 behind:0,0.2,-1; done
 scene potato own 10 behind:0,0.2,-1
 for mat in potato skin1 marble; do scene $mat own 30 sky:sky; done
 scene potato own 10 sky:sky
+# The other target scenes: skies at 15 and 100 mm and over ketchup, the sun at eta 1 at 15 mm
+# and over ketchup (a sphere of 3.6 mean free paths in red).
+scene ketchup own 30 sky:sky
+for mat in potato skin1 marble; do scene $mat own 15 sky:sky; done
+scene ketchup own 100 sky:sky
+scene potato 1.0 15 front:0.4,0.5,1
+scene ketchup 1.0 30 front:0.4,0.5,1
