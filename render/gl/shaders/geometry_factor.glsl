@@ -1,8 +1,8 @@
 // lucent GLSL 1: twin of materials/include/lucent/materials/geometry_factor.h (GeometryFactor): the
 // factor per channel by which the object's shape between the entry point (x_i, n_i) and the exit
 // point (x_o, n_o) changes a radial profile's multiple scattering: the flux of each beam's
-// diffusion sources (four along its refracted direction, each with its Kelvin image) through the
-// osculating sphere over a plane's at the same chord (1 on a plane; reciprocal).
+// diffusion sources (three along its refracted direction, each with its Kelvin image) through the
+// osculating sphere over a plane's at the same chord (1 on a plane); the entry's side only.
 // u_geometry_channels[c] = (sigma_tr, z_r, z_v, 1 where the channel scatters), set by
 // gl::set_geometry_factor_uniforms; 1 when u_geometry_factor is off.
 // tests/render/geometry_factor_test.cpp holds it against the C++.
@@ -13,8 +13,8 @@ uniform bool u_geometry_factor;
 uniform vec4 u_geometry_channels[3];
 
 const float kGeometryFactorMax = 64.0;
-const float kBeamDepths[4] = float[4](0.3225476896, 1.7457611012, 4.5366202969, 9.3950709123);
-const float kBeamDepthWeights[4] = float[4](0.6031541043, 0.3574186924, 0.0388879085, 0.0005392947);
+const float kBeamDepths[3] = float[3](0.4157745568, 2.2942803603, 6.2899450829);
+const float kBeamDepthWeights[3] = float[3](0.7110930099, 0.2785177336, 0.0103892565);
 
 // (1 + s) e^(s0 - s) / d^3 with s = sigma_tr d, per channel.
 vec3 geometry_term(vec3 sigma_tr, vec3 d2, vec3 s0) {
@@ -45,7 +45,7 @@ vec3 geometry_one_way(vec3 x, vec3 n, vec3 d, float inv_a_raw, vec3 sigma_tr, ve
   vec3 s0 = sigma_tr * r;
   vec3 lift = 1.0 + z_b * inv_a;
   vec3 sphere = vec3(0.0), plane = vec3(0.0);
-  for (int k = 0; k < 4; ++k) {
+  for (int k = 0; k < 3; ++k) {
     vec3 s = min(kBeamDepths[k] * z_r, reach);
     vec3 u_t = s * w_t, u_b = s * w_b, u_n = -s * cos_t;
     vec3 lateral = (r - u_t) * (r - u_t) + u_b * u_b;
@@ -69,8 +69,10 @@ vec3 geometry_one_way(vec3 x, vec3 n, vec3 d, float inv_a_raw, vec3 sigma_tr, ve
 }
 
 // G for a beam entering at x_i (normal n_i) with refracted tangential part d_i and light leaving at
-// x_o (n_o) toward a view whose reversed ray's is d_o (0: normal).
-vec3 geometry_factor(vec3 x_i, vec3 n_i, vec3 d_i, vec3 x_o, vec3 n_o, vec3 d_o) {
+// x_o (n_o): the entry's one-way factor (GeometryFactor::from_entry), the maps' form: the gather
+// does not know the exit's view, and the reciprocal mean with a normal exit's cost the render a sixth
+// more on llvmpipe and gave the far field a normal beam's gain.
+vec3 geometry_factor(vec3 x_i, vec3 n_i, vec3 d_i, vec3 x_o, vec3 n_o) {
   if (!u_geometry_factor) return vec3(1.0);
   vec3 sigma_tr =
       vec3(u_geometry_channels[0].x, u_geometry_channels[1].x, u_geometry_channels[2].x);
@@ -80,8 +82,7 @@ vec3 geometry_factor(vec3 x_i, vec3 n_i, vec3 d_i, vec3 x_o, vec3 n_o, vec3 d_o)
   vec3 x = x_o - x_i;
   float r2 = dot(x, x);
   float inv_a = dot(x, n_o - n_i) / max(r2, 1e-30);
-  vec3 g = sqrt(geometry_one_way(x, n_i, d_i, inv_a, sigma_tr, z_r, z_b) *
-                geometry_one_way(-x, n_o, d_o, inv_a, sigma_tr, z_r, z_b));
+  vec3 g = geometry_one_way(x, n_i, d_i, inv_a, sigma_tr, z_r, z_b);
   // Coincident points, or a channel that does not scatter: 1.
   bvec3 defined = bvec3(r2 > 1e-12 * z_r.x * z_r.x && u_geometry_channels[0].w > 0.5,
                         r2 > 1e-12 * z_r.y * z_r.y && u_geometry_channels[1].w > 0.5,

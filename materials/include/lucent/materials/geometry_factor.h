@@ -19,23 +19,26 @@
 // source's flux through the sphere at chord r is
 //   J = q f(d) (x_o - s) . n_o,  f(d) = (1 + sigma_tr d) e^(-sigma_tr d) / d^3.
 // The source is not a point at z_r = 1 / sigma_t' as in the dipole but the beam's own depth
-// distribution, sigma_t' e^(-sigma_t' z): four Gauss-Laguerre depths t_k / sigma_t' (weights w_k,
-// mean z_r), each with its image, in both the sphere's sum and the plane's (depths beyond 0.9 a
-// held at 0.9 a: the source must stay inside). The point source misses a tenth near the entry.
+// distribution, sigma_t' e^(-sigma_t' z): three Gauss-Laguerre depths t_k / sigma_t' (weights w_k,
+// mean z_r) along the refracted beam (the normal for a normal beam), each with its image, in both
+// the sphere's sum and the plane's, kept within 0.9 of the way to the beam's closest approach to the
+// centre (0.9 a for a normal beam). The point source misses a tenth near the entry.
 //
 // In the entry point's frame (origin x_i, z along n_i, the sphere's centre at -a z) everything is a
-// function of r and 1/a, with no difference of large numbers as a grows: the exit point is
-// (r cos(g/2), 0, -r sin(g/2)) with sin(g/2) = r / (2 a), its normal at angle g from z, and a
-// source at height s on the axis is at d^2 = r^2 + 2 r sin(g/2) s + s^2 with
-// (x_o - s) . n_o = r sin(g/2) - s cos(g); the image of depth z sits at
-// s = (2 z_b + z_b^2 / a + z) / (1 - z / a) with strength -(1 + z_b / a) / (1 - z / a).
-// G depends on the pair only through r and 1/a, both symmetric in the two points: reciprocal.
+// function of r and 1/a (and the beam's direction), with no difference of large numbers as a
+// grows: the exit point is (r cos(g/2), 0, -r sin(g/2)) with sin(g/2) = r / (2 a), its normal at
+// angle g from z; for a normal beam the image of depth z sits at s = (2 z_b + z_b^2 / a + z) /
+// (1 - z / a) on the axis with strength -(1 + z_b / a) / (1 - z / a) (one_way_in_frame has the
+// general form). With normal beams G depends on the pair only through r and 1/a, both symmetric in
+// the two points; with oblique ones it is the geometric mean of the two beams' one-way factors:
+// reciprocal either way.
 //
-// Against Monte Carlo of a normal beam into spheres of 1.5-30 mean free paths (isotropic, Fresnel
+// Against Monte Carlo of a normal beam into spheres of 1.5-10 mean free paths (isotropic, Fresnel
 // boundary, eta 1-1.5, alpha' 0.8-0.999; notebooks_data/bench/sphere_factor_mc.md, written
-// independently in numpy): within 10% of the true R_sphere(r) / R_plane(r) from the entry to 3-4
-// mean free paths, 10-25% beyond (where the profile is down by e^(-sigma_tr r)), where the former
-// modified-tangent-plane factor gave 1.12 for a true 1.32 at one mean free path on a sphere of 3.4.
+// independently in numpy): within 17% of the true R_sphere(r) / R_plane(r) to 2 mean free paths
+// from the entry, 35% to 4 (tests/render/geometry_factor_test.cpp), where the former
+// modified-tangent-plane factor gave 1.12 for a true 1.32 at one mean free path on a sphere of 3.4
+// and was 41% short at 3.4 (alpha' 0.8).
 #pragma once
 
 #include <algorithm>
@@ -57,11 +60,12 @@ inline bool geometry_factor_applies(DiffusionModel model) {
   return model != DiffusionModel::kDirectionalDipole;
 }
 
-/// Gauss-Laguerre nodes and weights (4 points) for the beam's depths, in mean free paths.
-inline constexpr std::array<double, 4> kBeamDepths = {0.3225476896193923, 1.745761101158347,
-                                                      4.536620296921128, 9.395070912301133};
-inline constexpr std::array<double, 4> kBeamDepthWeights = {
-    0.6031541043416336, 0.3574186924377997, 0.03888790851500538, 0.0005392947055613275};
+/// Gauss-Laguerre nodes and weights (3 points) for the beam's depths, in mean free paths (4 points
+/// moved G by a few per cent and cost the maps' gather a third more).
+inline constexpr std::array<double, 3> kBeamDepths = {0.4157745567834791, 2.294280360279042,
+                                                      6.289945082937479};
+inline constexpr std::array<double, 3> kBeamDepthWeights = {0.7110930099291730, 0.2785177335692408,
+                                                            0.01038925650158614};
 
 template <typename T>
 class GeometryFactor {
@@ -97,6 +101,17 @@ class GeometryFactor {
     if (!(r2 > T(1e-12) * c_.z_r * c_.z_r)) return T(1);
     const T inv_a = x.dot(n_o - n_i) / r2;
     return std::sqrt(one_way(x, n_i, d_i, inv_a) * one_way(Vec3(-x), n_o, d_o, inv_a));
+  }
+
+  /// The entry's one-way factor alone, g(i -> o; d_i): the maps' form (their gather does not know
+  /// the exit's view; GLSL twin geometry_factor.glsl). Not reciprocal.
+  T from_entry(const Vec3& x_i, const Vec3& n_i, const Vec3& d_i, const Vec3& x_o,
+               const Vec3& n_o) const {
+    if (!c_.scatters()) return T(1);
+    const Vec3 x = x_o - x_i;
+    const T r2 = x.squaredNorm();
+    if (!(r2 > T(1e-12) * c_.z_r * c_.z_r)) return T(1);
+    return one_way(x, n_i, d_i, x.dot(n_o - n_i) / r2);
   }
 
   /// G at chord r (mm) on a sphere of curvature inv_a = 1/a (mm^-1; negative: concave), both beams

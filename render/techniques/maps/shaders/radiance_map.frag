@@ -210,13 +210,13 @@ void main() {
 #endif
       E *= cos_i / max(dot(n_plane, w_i), 0.15);
       // The shape's factor places the beam's sources along its refracted direction where the
-      // skew is on (as the reference does); the exit's view is not known here: a normal one.
+      // skew is on (as the reference does); the exit's view is not known here: the entry's side.
       vec3 d_i = any(greaterThan(u_mean_free_path, vec3(0.0)))
                      ? oblique_displacement(w_i, n_i, u_eta)
                      : vec3(0.0);
       sum += sample_.z * fresnel_transmittance(cos_i, u_eta) * fur_coat(cos_i) * E *
              bssrdf(x_i, n_i, w_i, x_o, n_o) * angular_factor(cos_i) *
-             geometry_factor(x_i, n_i, d_i, x_o, n_o, vec3(0.0));
+             geometry_factor(x_i, n_i, d_i, x_o, n_o);
     }
   }
   vec4 previous = u_has_previous ? texelFetch(u_previous, ivec3(texel, g_layer), 0) : vec4(0.0);
