@@ -190,8 +190,8 @@ TEST(ObliqueSkew, ReferenceMatchesThePathTracerAtEtaOne) {
   EXPECT_GT(worst[0], 0.10);  // the test sees what it fixes
 
   // The maps (the entry's skew in the gather, the exit's by a displaced read in the final pass) at
-  // K 8, N 16 of M 256, W 64, 8 frames: measured 1.08 / 1.08 / 1.07 at 32 px (the gather does not
-  // know the view: the shape's factor's exit side is a normal beam's, whose far field is larger).
+  // K 8, N 16 of M 256, W 64, 8 frames: measured 1.06 / 1.07 / 1.06 at 32 px (the shape's factor
+  // from the entry's side: the gather does not know the view; 1.07-1.08 with a normal exit).
   std::string why_not;
   if (!GlContext::try_create_headless(&why_not)) GTEST_SKIP() << "no headless OpenGL: " << why_not;
   RenderSettings settings;

@@ -77,13 +77,9 @@ class GeometryFactor {
   explicit GeometryFactor(const DiffusionCoefficients<T>& c) : c_(c) {}
 
   /// G for light entering at x_i (outward unit normal n_i) and leaving at x_o (n_o), mm, both
-  /// beams normal to the surface (the osculating sphere's closed form below).
+  /// beams normal to the surface (then either one-way factor is the pair's: reciprocal as it is).
   T operator()(const Vec3& x_i, const Vec3& n_i, const Vec3& x_o, const Vec3& n_o) const {
-    if (!c_.scatters()) return T(1);
-    const Vec3 x = x_o - x_i;
-    const T r2 = x.squaredNorm();
-    if (!(r2 > T(1e-12) * c_.z_r * c_.z_r)) return T(1);
-    return of_curvature(std::sqrt(r2), x.dot(n_o - n_i) / r2);
+    return from_entry(x_i, n_i, Vec3::Zero(), x_o, n_o);
   }
 
   /// G for a beam entering at x_i whose refracted direction's tangential part is d_i
@@ -112,13 +108,6 @@ class GeometryFactor {
     const T r2 = x.squaredNorm();
     if (!(r2 > T(1e-12) * c_.z_r * c_.z_r)) return T(1);
     return one_way(x, n_i, d_i, x.dot(n_o - n_i) / r2);
-  }
-
-  /// G at chord r (mm) on a sphere of curvature inv_a = 1/a (mm^-1; negative: concave), both beams
-  /// normal.
-  T of_curvature(T r, T inv_a) const {
-    if (!c_.scatters()) return T(1);
-    return one_way_in_frame(r, clamp_curvature(inv_a), T(0), T(0), T(1));
   }
 
   /// One way, from the entry (at the origin, normal n, beam d) to the exit x away.
