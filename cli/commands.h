@@ -15,6 +15,7 @@ void register_render_command(CLI::App& app);
 void register_view_command(CLI::App& app);
 void register_tabulate_command(CLI::App& app);
 void register_compare_command(CLI::App& app);
+void register_tonemap_command(CLI::App& app);
 void register_material_commands(CLI::App& app);
 void register_merge_command(CLI::App& app);
 

@@ -1,8 +1,11 @@
 // `lucent compare`: how far a render is from a reference (relative RMSE, per-channel mean ratios)
 // over the pixels where the reference shows the object.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -23,6 +26,7 @@ namespace {
 
 struct CompareArguments {
   std::string image, reference;
+  std::string exposure = "auto";  ///< a PNG against an EXR: the EXR's exposure (or auto)
   bool json = false;
   std::string difference;
   float scale = 10;
@@ -30,20 +34,63 @@ struct CompareArguments {
   bool fit_scale = false;
 };
 
+bool is_png(const std::string& path) {
+  std::string e = std::filesystem::path(path).extension().string();
+  for (char& c : e) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return e == ".png";
+}
+
+// An EXR's linear render, refused with the pixel where it is not radiance.
+render::ImageRgb read_linear(const std::string& path) {
+  const render::ImageRgb im = imaging::read_exr(path);
+  // Renders are radiance: finite and >= 0 (a NaN or negative pixel made a NaN or negative RMSE).
+  for (std::size_t i = 0; i < im.data.size(); ++i)
+    if (!std::isfinite(im.data[i]) || im.data[i] < 0) {
+      const std::size_t p = i / 3;
+      throw Error(path + ": pixel (" + std::to_string(p % std::size_t(im.width)) + ", " +
+                  std::to_string(p / std::size_t(im.width)) + ") is " +
+                  (std::isfinite(im.data[i]) ? "negative" : "not finite") +
+                  ": expected a linear render (radiance >= 0)");
+    }
+  return im;
+}
+
+void check_extension(const std::string& path, const std::string& what) {
+  std::string e = std::filesystem::path(path).extension().string();
+  for (char& c : e) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (e != ".png" && e != ".exr") {
+    throw Error(path + ": the " + what + " must be a render, .exr (linear) or .png (tone-mapped)");
+  }
+}
+
 void run_compare(const CompareArguments& args) {
   if (!args.difference.empty()) check_output_file(args.difference, "", "--difference");
-  const render::ImageRgb image = imaging::read_exr(args.image);
-  const render::ImageRgb reference = imaging::read_exr(args.reference);
-  // Renders are radiance: finite and >= 0 (a NaN or negative pixel made a NaN or negative RMSE).
-  for (const auto& [im, path] : {std::pair{&image, &args.image}, std::pair{&reference, &args.reference}})
-    for (std::size_t i = 0; i < im->data.size(); ++i)
-      if (!std::isfinite(im->data[i]) || im->data[i] < 0) {
-        const std::size_t p = i / 3;
-        throw Error(*path + ": pixel (" + std::to_string(p % std::size_t(im->width)) + ", " +
-                    std::to_string(p / std::size_t(im->width)) + ") is " +
-                    (std::isfinite(im->data[i]) ? "negative" : "not finite") +
-                    ": expected a linear render (radiance >= 0)");
-      }
+  check_extension(args.image, "image");
+  check_extension(args.reference, "reference");
+  std::optional<float> fixed_exposure;
+  if (args.exposure != "auto") {
+    char* end = nullptr;
+    const float e = std::strtof(args.exposure.c_str(), &end);
+    if (end == args.exposure.c_str() || *end != '\0' || !(e > 0) || !std::isfinite(e))
+      throw Error("--exposure: expected a positive number or auto, got '" + args.exposure + "'");
+    fixed_exposure = e;
+  }
+  // Two EXRs are compared as linear radiance; where either is a PNG (tone-mapped, 8 bits), both
+  // as displayed (render::displayed): the EXR after the exposure (auto: its own, the rule
+  // `render` writes PNGs with) and the tone curve, the PNG decoded from sRGB.
+  const bool as_displayed = is_png(args.image) || is_png(args.reference);
+  float exposure = 0;
+  const auto read = [&](const std::string& path) {
+    if (is_png(path)) return render::displayed(imaging::read_raw_image(path));
+    render::ImageRgb linear = read_linear(path);
+    if (!as_displayed) return linear;
+    render::ToneMapOptions tone;
+    tone.exposure = fixed_exposure ? *fixed_exposure : render::auto_exposure(linear);
+    exposure = tone.exposure;
+    return render::displayed(linear, tone);
+  };
+  const render::ImageRgb image = read(args.image);
+  const render::ImageRgb reference = read(args.reference);
   if (image.width != reference.width || image.height != reference.height)
     throw Error(args.image + ": " + std::to_string(image.width) + " x " +
                 std::to_string(image.height) + " pixels, the reference " + args.reference + " " +
@@ -84,13 +131,15 @@ void run_compare(const CompareArguments& args) {
   }
   if (args.json) {
     nlohmann::json doc = {{"format", "lucent-image-difference"},
-                                {"version", 1},
-                                {"image", args.image},
-                                {"reference", args.reference},
-                                {"pixels", d.pixels},
-                                {"relative_rmse", d.relative_rmse},
-                                {"mean_ratio", d.mean_ratio},
-                                {"reference_mean", d.reference_mean}};
+                          {"version", 1},
+                          {"image", args.image},
+                          {"reference", args.reference},
+                          {"pixels", d.pixels},
+                          {"relative_rmse", d.relative_rmse},
+                          {"mean_ratio", d.mean_ratio},
+                          {"reference_mean", d.reference_mean},
+                          {"space", as_displayed ? "displayed" : "linear"}};
+    if (as_displayed && exposure > 0) doc["exposure"] = exposure;
     if (d.blocks > 0) {
       doc["blocks"] = d.blocks;
       doc["block_relative_rmse"] = d.block_relative_rmse;
@@ -104,7 +153,12 @@ void run_compare(const CompareArguments& args) {
     check_finite_json(doc, "compare --json");
     std::printf("%s\n", doc.dump(2).c_str());
   } else {
-    std::printf("compare: %s\n", d.to_string().c_str());
+    std::printf("compare: %s%s\n", d.to_string().c_str(),
+                as_displayed ? (exposure > 0 ? ", as displayed (the EXR at exposure " +
+                                                   std::to_string(exposure) + ")"
+                                             : std::string(", as displayed"))
+                                   .c_str()
+                             : "");
     if (scaled) std::printf("compare (scaled): %s\n", scaled->to_string().c_str());
   }
 }
@@ -115,13 +169,20 @@ void register_compare_command(CLI::App& app) {
   auto args = std::make_shared<CompareArguments>();
   CLI::App* cmd = app.add_subcommand(
       "compare",
-      "How far a linear render (EXR) is from a reference render of the same size: relative RMSE "
+      "How far a render is from a reference render of the same size (EXR linear, PNG tone-mapped: "
+      "two EXRs are compared as radiance; where either is a PNG both are compared as displayed, "
+      "the EXR tone-mapped at --exposure): relative RMSE "
       "(RMSE over pixels and channels / the reference's mean), the same over 4x4 blocks of pixels "
       "(each block's mean; the blocks wholly on the object) and per-channel mean ratios, over the "
       "pixels where the reference is not black");
-  cmd->add_option("image", args->image, "the render to judge (.exr)")->required();
-  cmd->add_option("reference", args->reference, "the reference (.exr), e.g. --technique reference")
+  cmd->add_option("image", args->image, "the render to judge (.exr or .png)")->required();
+  cmd->add_option("reference", args->reference,
+                  "the reference (.exr or .png), e.g. --technique reference")
       ->required();
+  cmd->add_option("--exposure", args->exposure,
+                  "an EXR held against a PNG: its exposure before the tone curve, or auto (the "
+                  "rule render writes PNGs with)")
+      ->capture_default_str();
   cmd->add_flag("--json", args->json, "print a JSON summary (lucent-image-difference)");
   cmd->add_option(
       "--difference", args->difference,

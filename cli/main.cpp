@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   lucent::cli::register_material_commands(app);
   lucent::cli::register_merge_command(app);
   lucent::cli::register_compare_command(app);
+  lucent::cli::register_tonemap_command(app);
   // `lucent SUB --version` works as the README says, on every subcommand.
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
     sub->set_version_flag("--version", std::string("lucent ") + lucent::kVersion);

@@ -29,7 +29,8 @@ inline std::string duration_text(double seconds) {
 
 class ProgressLine {
  public:
-  /// `what`: the command's name; `unit`: what is counted ("photons"). Quiet: prints nothing.
+  /// `what`: the command's name; `unit`: what is counted ("photons"; empty: a share of the work).
+  /// Quiet: prints nothing.
   ProgressLine(std::string what, std::string unit, bool quiet)
       : what_(std::move(what)),
         unit_(std::move(unit)),
@@ -48,9 +49,11 @@ class ProgressLine {
     last_tenth_ = tenth;
     const double elapsed = std::chrono::duration<double>(now - start_).count();
     const double left = elapsed * double(total - done) / double(done);
-    std::fprintf(stderr, "%s%s: %d%% of %llu %s, %s left%s", terminal_ ? "\r" : "", what_.c_str(),
-                 int(100 * done / total), static_cast<unsigned long long>(total), unit_.c_str(),
-                 duration_text(left).c_str(), terminal_ ? "   " : "\n");
+    // Without a unit the count is only a share ("render: 40%, 3 s left").
+    const std::string of = unit_.empty() ? "" : " of " + std::to_string(total) + " " + unit_;
+    std::fprintf(stderr, "%s%s: %d%%%s, %s left%s", terminal_ ? "\r" : "", what_.c_str(),
+                 int(100 * done / total), of.c_str(), duration_text(left).c_str(),
+                 terminal_ ? "   " : "\n");
     std::fflush(stderr);
     drawn_ = true;
   }

@@ -4,11 +4,13 @@
 // input fails fast and leaves no output file.
 #include <unistd.h>
 
-#include <chrono>
 #include <cctype>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -17,18 +19,24 @@
 #include "lucent/core/atomic_file.h"
 #include "lucent/core/error.h"
 #include "lucent/core/json_file.h"
+#include "lucent/render/frame_budget.h"
 #include "lucent/render/render_settings.h"
 #include "lucent/render/scene.h"
 #include "lucent/render/technique.h"
 #include "lucent/render/tone_map.h"
+#include "progress.h"
 #include "scene_options.h"
+#include "technique_flags.h"
 
 namespace lucent::cli {
 namespace {
 
 struct RenderArguments {
   SceneArguments scene;
-  std::string output;
+  std::vector<std::string> outputs;  ///< -o, a PNG, an EXR or one of each
+  std::string output;                ///< the first of them (snapshots, messages)
+  std::string budget = "60";         ///< --budget: seconds per image, or none
+  render::FixedKnobs fixed;          ///< the maps' knobs given on the command line
   std::string stats;
   std::vector<int> snapshots;
   bool json = false;
@@ -40,26 +48,110 @@ std::string snapshot_path(const std::string& output, int frame) {
   return output.substr(0, dot) + ".f" + std::to_string(frame) + ".exr";
 }
 
-void print_progress(double fraction) {
-  std::fprintf(stderr, "\rrender: %3d%%", int(std::lround(100 * fraction)));
-  std::fflush(stderr);
+// --budget: seconds per image (> 0), or none (infinity: the requested quality whatever it costs).
+double parse_budget(const std::string& text) {
+  if (text == "none") return std::numeric_limits<double>::infinity();
+  char* end = nullptr;
+  const double s = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0' || !(s > 0) || !std::isfinite(s)) {
+    throw Error("--budget: expected seconds per image (> 0) or none, got '" + text + "'");
+  }
+  return s;
+}
+
+std::string lower_extension(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return extension;
+}
+
+// The outputs (-o, one PNG and one EXR at most), checked before any work: the right extensions,
+// writable folders, not the same kind twice.
+void check_outputs(RenderArguments& render_args) {
+  if (render_args.outputs.empty()) throw Error("-o: give the output image (.png or .exr)");
+  bool png = false, exr = false;
+  for (const std::string& output : render_args.outputs) {
+    if (!render::is_render_image_path(output)) {
+      throw Error("-o: '" + output + "': output must be .png (tone-mapped) or .exr (linear)");
+    }
+    bool& seen = lower_extension(output) == ".png" ? png : exr;
+    if (seen) throw Error("-o: '" + output + "': at most one .png and one .exr");
+    seen = true;
+    check_output_file(output, "", "-o");
+  }
+  render_args.output = render_args.outputs.front();
+}
+
+struct Written {
+  float exposure = 1;
+};
+
+// Every output from one linear image: PNG with the exposure (auto: the image's own), EXR linear.
+Written write_outputs(const RenderArguments& render_args, const render::ImageRgb& image,
+                      const render::Scene& scene, const std::string& technique) {
+  render::ToneMapOptions tone;
+  tone.exposure = render_args.scene.auto_exposure ? render::auto_exposure(image)
+                                                  : render_args.scene.options.settings.exposure;
+  for (const std::string& path : render_args.outputs) {
+    render::write_render_image(path, image, tone,
+                               {{"lucent:units", "radiance, W mm^-2 sr^-1 per unit light"},
+                                {"lucent:material", scene.material.name},
+                                {"lucent:mesh", scene.mesh.name},
+                                {"lucent:technique", technique}});
+  }
+  return {tone.exposure};
+}
+
+// The maps within --budget: the coarse image first, written at once, then the refined levels.
+render::ImageRgb render_maps_budgeted(RenderArguments& render_args, const render::Scene& scene,
+                                      const render::TechniqueOptions& options,
+                                      ProgressLine& progress, render::RenderStats& stats,
+                                      nlohmann::json& budget_doc) {
+  using namespace lucent::render;
+  BudgetedMapsOptions budget;
+  budget.ladder = maps_quality_ladder(options.settings, render_args.fixed);
+  budget.budget_s = parse_budget(render_args.budget);
+  const auto start = std::chrono::steady_clock::now();
+  budget.on_image = [&](const ImageRgb& image, int level) {
+    write_outputs(render_args, image, scene, "radiance maps");
+    progress.finish();
+    const double t =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::fprintf(stderr, "render: %s image in %s after %.1f s (%s)\n",
+                 level == 0 ? "a first coarse" : "a refined", render_args.output.c_str(), t,
+                 quality_text(budget.ladder[std::size_t(level)]).c_str());
+    std::fflush(stderr);
+  };
+  budget.progress = [&](double fraction, double) {
+    progress.update(std::uint64_t(std::lround(1000 * fraction)), 1000);
+  };
+  const BudgetedMaps result =
+      render_radiance_maps_within_budget(scene, options.maps, budget, &stats);
+  const RenderSettings& used = budget.ladder[std::size_t(result.level)];
+  const RenderSettings& requested = budget.ladder.back();
+  budget_doc = {{"budget_s", std::isinf(budget.budget_s) ? nlohmann::json("none")
+                                                         : nlohmann::json(budget.budget_s)},
+                {"levels", budget.ladder.size()},
+                {"level", result.level},
+                {"levels_run", result.levels_run},
+                {"level_seconds", result.level_seconds},
+                {"quality", quality_text(used)},
+                {"requested", quality_text(requested)},
+                {"requested_reached", result.level + 1 == int(budget.ladder.size())},
+                {"requested_predicted_s", requested.frames * result.requested_frame_ms / 1000}};
+  return result.image;
 }
 
 void run_render(RenderArguments& render_args) {
   using namespace lucent::render;
   SceneArguments& args = render_args.scene;
-  if (render_args.output.empty()) throw Error("-o: give the output image (.png or .exr)");
-  if (!is_render_image_path(render_args.output)) {
-    throw Error("-o: '" + render_args.output +
-                "': output must be .png (tone-mapped) or .exr (linear)");
-  }
+  check_outputs(render_args);
   // Where the outputs go is checked before any work (they are written together at the end).
-  check_output_file(render_args.output, "", "-o");
   if (!render_args.stats.empty()) check_output_file(render_args.stats, ".json", "--stats");
+  parse_budget(render_args.budget);
   Scene scene = build_scene(args).scene;
   const auto start = std::chrono::steady_clock::now();
 
-  const bool show_progress = ::isatty(STDERR_FILENO) != 0;
   const TechniqueInfo& technique = technique_info(args.technique_id);
   if (!technique.frame_snapshots && !render_args.snapshots.empty()) {
     throw Error("--snapshots: frame snapshots are of the radiance maps (--technique maps)");
@@ -75,30 +167,46 @@ void run_render(RenderArguments& render_args) {
   options.maps.on_snapshot = [&](int t, const ImageRgb& snapshot) {
     write_render_image(snapshot_path(render_args.output, t), snapshot, ToneMapOptions{});
   };
-  bool progress_shown = false;  // the techniques that report progress end their line here
-  if (show_progress) {
-    options.reference.progress = [&progress_shown](double fraction) {
-      progress_shown = true;
-      print_progress(fraction);
-    };
-    options.pathtrace.progress = options.reference.progress;
-  }
+  // Progress of every technique: the share done (the frame-by-frame ones by frames, the CPU ones
+  // by their passes), on a terminal one redrawn line, elsewhere a line per tenth.
+  ProgressLine progress("render", "", false);
+  const auto report = [&progress](double fraction) {
+    progress.update(std::uint64_t(std::lround(1000 * fraction)), 1000);
+  };
+  options.reference.progress = report;
+  options.pathtrace.progress = report;
   RenderStats stats;
-  const ImageRgb image = render_still(args.technique_id, scene, options, &stats);
-  if (progress_shown) std::fprintf(stderr, "\n");
-
-  ToneMapOptions tone;
-  tone.exposure = args.auto_exposure ? auto_exposure(image) : options.settings.exposure;
-  write_render_image(render_args.output, image, tone,
-                     {{"lucent:units", "radiance, W mm^-2 sr^-1 per unit light"},
-                      {"lucent:material", scene.material.name},
-                      {"lucent:mesh", scene.mesh.name},
-                      {"lucent:technique", technique.name}});
+  nlohmann::json budget_doc;
+  const bool budgeted = args.technique_id == TechniqueId::kMaps && render_args.snapshots.empty();
+  std::vector<std::string> written;  // removed again if a later stage fails
+  ImageRgb image;
+  // The frame-by-frame techniques other than the maps: a ticker of the time so far on a terminal
+  // (their set-up, the hierarchical links above all, has no share to report).
+  std::unique_ptr<StageProgress> stages;
+  if (!budgeted && technique.gpu) {
+    stages = std::make_unique<StageProgress>("render", false);
+    stages->stage("rendering (" + technique.label + ")", 0);
+  }
+  try {
+    image = budgeted
+                ? render_maps_budgeted(render_args, scene, options, progress, stats, budget_doc)
+                : render_still(args.technique_id, scene, options, &stats);
+  } catch (...) {
+    progress.finish();
+    stages.reset();
+    if (budgeted) {
+      std::error_code ignored;
+      for (const std::string& path : render_args.outputs) std::filesystem::remove(path, ignored);
+    }
+    throw;
+  }
+  progress.finish();
+  stages.reset();
+  const Written out = write_outputs(render_args, image, scene, technique.name);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::string extension = std::filesystem::path(render_args.output).extension().string();
-  for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
-  const bool png = extension == ".png";  // EXR is written linear, without the exposure
+  bool png = false;
+  for (const std::string& path : render_args.outputs) png = png || lower_extension(path) == ".png";
   nlohmann::json doc = stats.to_json();
   doc["scene"] = {{"material", scene.material.name},
                   {"model", materials::to_string(options.settings.model)},
@@ -108,29 +216,42 @@ void run_render(RenderArguments& render_args) {
                   {"lights", scene.lights.size()},
                   {"environment", args.env},
                   {"view", args.view}};
+  if (!budget_doc.is_null()) doc["budget"] = budget_doc;
   if (const std::string settings = settings_text(args.technique_id, options); !settings.empty())
     doc["settings"] = settings;
   if (!render_args.stats.empty()) {
     check_finite_json(doc, render_args.stats);
     write_file_atomically(render_args.stats, doc.dump(2) + "\n");
   }
+  std::string outputs;
+  for (const std::string& path : render_args.outputs)
+    outputs += (outputs.empty() ? "" : " and ") + path;
   if (render_args.json) {
     // The summary line as JSON, with the statistics (the same document as --stats).
     doc["output"] = render_args.output;
+    doc["outputs"] = render_args.outputs;
     doc["seconds"] = seconds;
-    doc["exposure"] = png ? nlohmann::json(tone.exposure) : nlohmann::json(nullptr);
+    doc["exposure"] = png ? nlohmann::json(out.exposure) : nlohmann::json(nullptr);
     doc["auto_exposure"] = png && args.auto_exposure;
     if (!render_args.stats.empty()) doc["stats_file"] = render_args.stats;
     check_finite_json(doc, "render --json");
     std::printf("%s\n", doc.dump(2).c_str());
   } else {
     std::printf(
-        "render: wrote %s (%dx%d, %s, %s on %s, %s%s) in %.1f s\n", render_args.output.c_str(),
+        "render: wrote %s (%dx%d, %s, %s on %s, %s%s) in %.1f s\n", outputs.c_str(),
         scene.camera.width, scene.camera.height, technique.label.c_str(),
         materials::to_string(options.settings.model).c_str(), scene.mesh.name.c_str(),
         png ? "exposure " : "linear",
-        png ? (std::to_string(tone.exposure) + (args.auto_exposure ? " (auto)" : "")).c_str() : "",
+        png ? (std::to_string(out.exposure) + (args.auto_exposure ? " (auto)" : "")).c_str() : "",
         seconds);
+    if (!budget_doc.is_null() && !budget_doc["requested_reached"].get<bool>()) {
+      std::printf(
+          "render: quality %s within --budget %s s; the requested %s would take about %s "
+          "(--budget none, or give the knobs)\n",
+          budget_doc["quality"].get<std::string>().c_str(), render_args.budget.c_str(),
+          budget_doc["requested"].get<std::string>().c_str(),
+          duration_text(budget_doc["requested_predicted_s"].get<double>()).c_str());
+    }
   }
   if (!args.default_rig.empty()) {
     std::string rig;
@@ -150,9 +271,17 @@ void register_render_command(CLI::App& app) {
       "is centred and scaled so that its bounding-box diagonal is --object-size-mm.");
   args->scene.size = "256x256";
   add_scene_options(cmd, args->scene, "image size WxH in pixels");
-  cmd->add_option("-o,--output", args->output,
-                  "output image: .png (tone-mapped sRGB) or .exr (linear); written atomically")
+  cmd->add_option("-o,--output", args->outputs,
+                  "output image: .png (tone-mapped sRGB) or .exr (linear), or one of each "
+                  "(-o a.png -o a.exr); written atomically")
       ->required();
+  cmd->add_option(
+         "--budget", args->budget,
+         "maps: seconds per image (or none). A coarse first image is written at once, then "
+         "the highest quality whose time, predicted from the frames measured, fits the "
+         "budget (the requested K, W_s, W_l, N, T when they fit); knobs given explicitly "
+         "are kept at every level")
+      ->capture_default_str();
   cmd->add_option("--snapshots", args->snapshots,
                   "maps: also write the linear image after these frames as OUT.f<t>.exr "
                   "(e.g. --snapshots 1,4,16)")
@@ -162,7 +291,10 @@ void register_render_command(CLI::App& app) {
   cmd->add_flag("--json", args->json,
                  "print what was written as JSON on stdout (output, size, technique, model, mesh, "
                  "exposure, time and the --stats document) instead of the summary line");
-  cmd->callback([args] { run_render(*args); });
+  cmd->callback([cmd, args] {
+    args->fixed = given_maps_knobs(cmd);  // explicit knobs win over the budget
+    run_render(*args);
+  });
 }
 
 }  // namespace lucent::cli

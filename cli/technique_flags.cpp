@@ -293,4 +293,21 @@ void warn_deprecated_flags(const CLI::App* cmd) {
   }
 }
 
+render::FixedKnobs given_maps_knobs(const CLI::App* cmd) {
+  const auto given = [cmd](const std::string& name, const std::string& alias) {
+    for (const std::string& n : {name, alias}) {
+      const CLI::Option* o = cmd->get_option_no_throw(n);
+      if (o != nullptr && o->count() > 0) return true;
+    }
+    return false;
+  };
+  render::FixedKnobs fixed;
+  fixed.frames = given("--maps-frames", "--frames");
+  fixed.directions = given("--maps-directions", "--directions");
+  fixed.samples = given("--maps-samples", "--samples");
+  fixed.radiance_map = given("--maps-radiance-map", "--radiance-map");
+  fixed.light_map = given("--maps-light-map", "--light-map");
+  return fixed;
+}
+
 }  // namespace lucent::cli

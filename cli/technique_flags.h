@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "lucent/render/frame_budget.h"
 #include "lucent/render/technique.h"
 
 namespace lucent::cli {
@@ -18,6 +19,9 @@ void add_technique_flags(CLI::App* cmd, render::TechniqueOptions& options);
 /// --maps-disc-points, --maps-radiance-map, --maps-light-map, with their earlier spellings), for
 /// commands that time the maps (`bench render`).
 void add_maps_sampling_flags(CLI::App* cmd, render::RenderSettings& settings);
+
+/// The maps' knobs given on `cmd`'s command line under either spelling (they win over a budget).
+render::FixedKnobs given_maps_knobs(const CLI::App* cmd);
 
 /// One line on stderr naming the deprecated spellings `cmd` was given and their new names; nothing
 /// when none was used.

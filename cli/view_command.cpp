@@ -12,6 +12,8 @@
 #include "lucent/core/error.h"
 #include "progress.h"
 #include "scene_options.h"
+#include "technique_flags.h"
+#include "validators.h"
 #if LUCENT_HAS_VIEWER
 #include "lucent/render/viewer.h"
 #endif
@@ -24,6 +26,8 @@ struct ViewArguments {
   float deform = 0;
   std::string script;
   bool hide_panel = false;
+  double frame_budget_ms = 50;
+  render::FixedKnobs fixed;
 };
 
 void run_view(ViewArguments& args) {
@@ -55,6 +59,8 @@ void run_view(ViewArguments& args) {
   options.deform_amplitude = args.deform;
   options.script = args.script;
   options.hide_panel = args.hide_panel;
+  options.frame_budget_ms = args.frame_budget_ms;
+  options.fixed = args.fixed;
   options.auto_exposure = args.scene.auto_exposure;
   if (!args.scene.default_rig.empty()) {
     std::string rig;
@@ -102,6 +108,13 @@ void register_view_command(CLI::App& app) {
                   "at most 0.2); the mesh moves every frame and the maps restart with it")
       ->capture_default_str();
   cmd->add_flag("--hide-panel", args->hide_panel, "start without the panel (H shows it)");
+  cmd->add_option("--frame-budget-ms", args->frame_budget_ms,
+                  "maps: the time a frame may take (ms); the knobs not given (K, W_s, W_l, N, T) "
+                  "are chosen from the frames measured to keep within it, coarse first, and the "
+                  "image is rendered at a lower resolution while it refines if even the coarsest "
+                  "is over it; 0: the knobs as given, whatever a frame costs")
+      ->check(number_in(0, 1e6, "ms", false))
+      ->capture_default_str();
   cmd->add_option(
       "--script", args->script,
       "actions, one per frame, separated by ';': orbit DX DY, light DX DY (pixels), "
@@ -109,7 +122,10 @@ void register_view_command(CLI::App& app) {
       "model), key LETTER, wait FRAMES, sleep SECONDS, settle (until the maps converge or the "
       "reference has a pass), screenshot FILE.png, panel on|off, difference on|off, restart, "
       "quit");
-  cmd->callback([args] { run_view(*args); });
+  cmd->callback([cmd, args] {
+    args->fixed = given_maps_knobs(cmd);
+    run_view(*args);
+  });
 }
 
 }  // namespace lucent::cli

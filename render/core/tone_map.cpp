@@ -30,6 +30,25 @@ float srgb_encode(float linear) {
   return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
 }
 
+float srgb_decode(float encoded) {
+  const float v = std::clamp(std::isnan(encoded) ? 0.0f : encoded, 0.0f, 1.0f);
+  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+
+imaging::ImageRgb displayed(const imaging::ImageRgb& linear, const ToneMapOptions& options) {
+  imaging::ImageRgb out = linear;
+  for (float& v : out.data) v = tone_curve(v * options.exposure);
+  return out;
+}
+
+imaging::ImageRgb displayed(const imaging::RawImage& png) {
+  imaging::ImageRgb out(png.width, png.height, 0.0f);
+  const float scale = 1.0f / float(png.max_value);
+  for (std::size_t i = 0; i < out.data.size(); ++i)
+    out.data[i] = srgb_decode(float(png.data[i]) * scale);
+  return out;
+}
+
 imaging::RawImage tone_map(const imaging::ImageRgb& linear, const ToneMapOptions& options) {
   imaging::RawImage out(linear.width, linear.height, 255);
   for (std::size_t i = 0; i < linear.data.size(); ++i) {

@@ -87,8 +87,8 @@ void draw_background(const Program& background, const Eigen::Matrix4f& view_proj
 }
 
 void draw_present(const Program& present, GLuint image, GLuint sampler, GLuint empty_vao,
-                  float exposure, int width, int height) {
-  glViewport(0, 0, width, height);
+                  float exposure, int x, int y, int width, int height) {
+  glViewport(x, y, width, height);
   glDisable(GL_DEPTH_TEST);
   present.use();
   glUniform1f(present.location("u_exposure"), exposure);
@@ -185,8 +185,8 @@ void FinalTarget::begin_frame(const Eigen::Matrix4f& view_proj, const Vec3f& bac
                   environment_unit_, backdrop, empty_vao_.id());
 }
 
-void FinalTarget::present(float exposure, int width, int height) const {
-  draw_present(present_, color_.id(), linear_.id(), empty_vao_.id(), exposure, width, height);
+void FinalTarget::present(float exposure, int x, int y, int width, int height) const {
+  draw_present(present_, color_.id(), linear_.id(), empty_vao_.id(), exposure, x, y, width, height);
 }
 
 std::vector<float> FinalTarget::read_rgba() const {

@@ -43,7 +43,7 @@ void draw_background(const Program& background, const Eigen::Matrix4f& view_proj
 
 /// present.frag: `image` tone-mapped with `exposure` into the bound draw framebuffer.
 void draw_present(const Program& present, GLuint image, GLuint sampler, GLuint empty_vao,
-                  float exposure, int width, int height);
+                  float exposure, int x, int y, int width, int height);
 
 /// The RGBA32F level 0 of `texture`, width x height, rows from the bottom (GL's order).
 std::vector<float> read_rgba(GLuint texture, int width, int height);
@@ -74,7 +74,7 @@ class FinalTarget {
   /// through `view_proj`: the environment, else the backdrop colour. Leaves depth testing off.
   void begin_frame(const Eigen::Matrix4f& view_proj, const Vec3f& backdrop) const;
   /// The colour tone-mapped with `exposure` into the bound draw framebuffer, width x height.
-  void present(float exposure, int width, int height) const;
+  void present(float exposure, int x, int y, int width, int height) const;
 
   std::vector<float> read_rgba() const;         ///< rows from the bottom (GL's order)
   ImageRgb read_image() const;                  ///< linear RGB, row 0 at the top

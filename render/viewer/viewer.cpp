@@ -24,6 +24,8 @@ Viewer::Viewer(const ViewerOptions& options)
   script_ = parse_script(options.script);
   show_ui_ = !options.hide_panel;
   auto_exposure_ = options.auto_exposure;
+  frame_budget_ms_ = options.frame_budget_ms;
+  fixed_ = options.fixed;
   settings_.validate();
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
@@ -56,14 +58,19 @@ Viewer::Viewer(const ViewerOptions& options)
   ImGui_ImplOpenGL3_Init("#version 450 core");
 
   glfwGetFramebufferSize(window_, &width_, &height_);
-  scene_.camera = view_.camera(scene_.mesh, std::max(width_, 1), std::max(height_, 1));
+  // The panel starts beside the image (folded in a small window); its width is known after its
+  // first frame, which then re-frames the camera.
+  panel_collapsed_ = width_ < 640 || height_ < 480;
+  if (show_ui_ && !panel_collapsed_) panel_width_ = default_panel_width();
+  const ViewRect r = view_rect();
+  scene_.camera = view_.camera(scene_.mesh, r.width, r.height);
   if (std::filesystem::is_regular_file(material_source_)) watcher_ = FileWatcher(material_source_);
   std::snprintf(material_path_.data(), material_path_.size(), "%s", material_source_.c_str());
   if (deform_amplitude_ != options.deform_amplitude) set_deform(options.deform_amplitude);
   rebuild_maps();
   cpu_worker_ = std::make_unique<CpuWorker>();
   if (on_cpu()) scene_changed();
-  last_time_ = glfwGetTime();
+  last_time_ = start_time_ = glfwGetTime();
 }
 
 Viewer::~Viewer() {
@@ -79,24 +86,37 @@ Viewer::~Viewer() {
 
 int Viewer::run() {
   while (!quit_ && !glfwWindowShouldClose(window_)) {
-    // Frames as fast as they come while the maps accumulate or the mesh moves; otherwise wake for
-    // input, a finished reference pass (the worker needs the CPU more than the window does) and,
-    // now and then, to watch the material file.
+    // Frames as fast as they come while something is to be rendered (the maps accumulate, the
+    // resolution comes back after refining, the mesh moves); otherwise nothing is rendered: wake
+    // for input, a finished reference pass (the worker needs the CPU more than the window does)
+    // and, now and then, to watch the material file.
     const Technique* t = live(technique_);
-    const bool accumulating = !on_cpu() && (t == nullptr || !t->converged() || deformer_ ||
-                                            (technique_ == TechniqueId::kFur && fur_lobe_));
-    if (accumulating) {
+    const bool busy = !on_cpu() && (t == nullptr || !t->converged() || redraw_ || deformer_ ||
+                                    render_scale_ < 1 || auto_exposure_ ||
+                                    (technique_ == TechniqueId::kFur && fur_lobe_));
+    if (busy) {
       glfwPollEvents();
     } else {
-      glfwWaitEventsTimeout(script_pos_ < script_.size() || on_cpu() ? 0.05 : 0.25);
+      glfwWaitEventsTimeout(script_pos_ < script_.size() || on_cpu() ? 0.05 : 0.5);
     }
     frame();
   }
+  const RenderSettings running = running_settings();
   std::printf(
-      "view: %ld frames drawn, %d restarts, %d screenshots; technique %s, accumulated %d of %d "
-      "frames\n",
-      frames_drawn_, restarts_, screenshots_, technique_info(technique_).name.c_str(),
-      maps_frames(), settings_.frames);
+      "view: %ld frames drawn, %ld rendered, %d restarts, %d screenshots; technique %s, "
+      "accumulated %d of %d frames\n",
+      frames_drawn_, frames_rendered_, restarts_, screenshots_,
+      technique_info(technique_).name.c_str(), maps_frames(), running.frames);
+  std::printf(
+      "view: quality level %d of %d (%s) for a frame budget of %g ms; longest frame "
+      "%.0f ms after the first second\n",
+      level_ + 1, int(maps_quality_ladder(settings_, fixed_).size()), quality_text(running).c_str(),
+      frame_budget_ms_, max_frame_ms_);
+  std::printf("view: panel %s, widest line %.0f of %.0f px\n",
+              !show_ui_          ? "hidden"
+              : panel_collapsed_ ? "folded"
+                                 : "open",
+              panel_content_width_, panel_inner_width_);
   return 0;
 }
 
@@ -104,6 +124,8 @@ void Viewer::frame() {
   const double now = glfwGetTime();
   frame_ms_ = 1000 * (now - last_time_);
   last_time_ = now;
+  if (now - start_time_ > 1.0 && frames_rendered_ > 2)
+    max_frame_ms_ = std::max(max_frame_ms_, frame_ms_);
   int w = 0, h = 0;
   glfwGetFramebufferSize(window_, &w, &h);
   if (w > 0 && h > 0 && (w != width_ || h != height_)) {
@@ -132,8 +154,12 @@ void Viewer::frame() {
   // The panel's text scales with the window: 1 at 720 pixels high, within 0.55..1.6.
   ImGui::GetIO().FontGlobalScale = std::clamp(float(height_) / 720.0f, 0.55f, 1.6f);
   ImGui::NewFrame();
+  const ViewRect before = view_rect();
   if (show_ui_) draw_ui();
   ImGui::Render();
+  const ViewRect after = view_rect();
+  if (after.x != before.x || after.width != before.width || after.height != before.height)
+    view_changed();  // the panel was resized, folded or opened
 
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   if (width_ > 0 && height_ > 0) {
@@ -192,6 +218,8 @@ void Viewer::run_script_step() {
     settle_deadline_ = now + kSettleTimeout;
   } else if (a.verb == "restart") {
     scene_changed();
+  } else if (a.verb == "save") {
+    save_material(a.args[0]);
   } else if (a.verb == "quit") {
     quit_ = true;
   } else if (a.verb == "screenshot") {
@@ -202,8 +230,10 @@ void Viewer::run_script_step() {
     screenshot_scripted_ = true;
   } else if (a.verb == "panel") {
     show_ui_ = a.args[0] == "on";
+    view_changed();
   } else if (a.verb == "difference") {
     show_difference_ = a.args[0] == "on";
+    if (show_difference_) set_render_scale(1);
   }
 }
 
@@ -212,8 +242,15 @@ void Viewer::handle_keys() {
   if (ImGui::GetIO().WantCaptureKeyboard) return;
   for (int key : keys) {
     if (key == GLFW_KEY_ESCAPE) quit_ = true;
-    if (key == GLFW_KEY_H) show_ui_ = !show_ui_;
-    if (key == GLFW_KEY_D) show_difference_ = !show_difference_;
+    if (key == GLFW_KEY_H) {
+      show_ui_ = !show_ui_;
+      view_changed();  // the image takes the panel's place, or gives it back
+    }
+    if (key == GLFW_KEY_E) auto_exposure_ = true;
+    if (key == GLFW_KEY_D) {
+      show_difference_ = !show_difference_;
+      if (show_difference_) set_render_scale(1);  // the view's resolution for the comparison
+    }
     if (key == GLFW_KEY_R) scene_changed();
     if (key == GLFW_KEY_L) fur_lobe_ = !fur_lobe_;  // fur: the seed's rotating lobe light
     if (key == GLFW_KEY_LEFT_BRACKET) scale_selected_light(1 / 1.25f);  // an area light's size
@@ -244,6 +281,7 @@ void Viewer::handle_mouse() {
       } else {
         drag_light(scene_.lights[std::size_t(selected_light_)], 0.4f * dx, -0.4f * dy);
         ++versions_.lights;
+        auto_exposure_ = true;  // taken once the image has settled again
         scene_changed();
       }
     }
@@ -259,21 +297,29 @@ void Viewer::handle_mouse() {
 
 void Viewer::view_changed() {
   ++scene_version_;  // the cached reference was of the old view
-  scene_.camera = view_.camera(scene_.mesh, std::max(width_, 1), std::max(height_, 1));
-  ++versions_.camera;
+  // Moving the view while the maps refine (or after): the final pass at the refining resolution
+  // until it settles again.
+  if (technique_ == TechniqueId::kMaps) render_scale_ = show_difference_ ? 1.0f : refine_scale_;
+  apply_camera();
   if (on_cpu()) scene_changed();
 }
 
 void Viewer::scene_changed() {
   ++restarts_;
   ++scene_version_;
+  redraw_ = true;
   for (LiveTechnique& t : live_)
     if (t.technique) t.technique->restart();
+  // The maps climb their levels again from the coarse one (set up before: no compiling).
+  if (frame_budget_ms_ > 0 && level_ > 0 && live(TechniqueId::kMaps) != nullptr) {
+    switch_maps_level(0);
+    live(TechniqueId::kMaps)->restart();
+  }
   if (on_cpu()) {
-    // Half the window's resolution in each direction: four times fewer pixels to integrate.
+    // Half the view's resolution in each direction: four times fewer pixels to integrate.
     Scene small = scene_;
-    small.camera.width = std::max(1, width_ / 2);
-    small.camera.height = std::max(1, height_ / 2);
+    const ViewRect r = view_rect();
+    small.camera = view_.camera(scene_.mesh, std::max(1, r.width / 2), std::max(1, r.height / 2));
     cpu_worker_->start(small, technique_, settings_.model, technique_options());
     reference_passes_ = 0;
   } else if (cpu_worker_) {
@@ -281,13 +327,21 @@ void Viewer::scene_changed() {
   }
 }
 
-void Viewer::rebuild_maps() {
+void Viewer::rebuild_maps(bool settings_changed) {
   try {
+    // New settings: the levels set up before are of the old ones. Back to the coarse level.
+    if (settings_changed) {
+      parked_maps_.clear();
+      if (frame_budget_ms_ > 0) level_ = 0;
+    }
     LiveTechnique& slot = live_[std::size_t(TechniqueId::kMaps)];
     std::unique_ptr<Technique> maps = make_technique(TechniqueId::kMaps);
     maps->setup(scene_, technique_options());
     slot = {std::move(maps), versions_, scene_.camera.width, scene_.camera.height};
     ++restarts_;
+    level_first_frame_ = true;  // it compiles its programs: not a frame to measure
+    apply_split();
+    redraw_ = true;
   } catch (const Error& e) {
     message_ = e.what();
     std::fprintf(stderr, "view: %s\n", e.what());
@@ -351,6 +405,7 @@ void Viewer::set_parameter(const std::string& given, const std::string& value) {
                   "model, exposure, object-size-mm, deform or light_scale (or the panel's N, M, q, "
                   "K, Ws, Wl, T, disc, size)");
     next.validate();
+    mark_explicit(name);
     settings_ = pending_ = next;
     rebuild_maps();
   }
@@ -367,6 +422,7 @@ void Viewer::load_material(const std::string& source) {
   material_source_ = source;
   watcher_ = std::filesystem::is_regular_file(source) ? FileWatcher(source) : FileWatcher();
   message_ = "material: " + scene_.material.name;
+  auto_exposure_ = true;  // another material: another brightness
   if (model_from_material_) {
     const DiffusionModel model = materials::preferred_model(scene_.material);
     if (model != settings_.model) {
@@ -427,6 +483,7 @@ void Viewer::set_deform(float amplitude) {
     apply_geometry();
     scene_changed();
   }
+  apply_split();  // whole frames while the mesh moves
 }
 
 void Viewer::apply_geometry() {

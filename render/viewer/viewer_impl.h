@@ -229,7 +229,13 @@ class Viewer {
 
   void view_changed();
   void scene_changed();  // lights, material or geometry: restart whatever is accumulating
-  void rebuild_maps();   // new RenderSettings: new textures and programs
+  // New RenderSettings (settings_changed: the levels parked before are dropped) or a level not set
+  // up yet: new textures and programs.
+  void rebuild_maps(bool settings_changed = true);
+  // The maps at another level of the ladder: the current one parked (programs compiled, textures
+  // kept), the other one taken from the park or set up.
+  void switch_maps_level(int level);
+  void apply_split();  // the frame split for the current level (plan_split)
   void set_parameter(const std::string& name, const std::string& value);
   void load_material(const std::string& source);
   void set_object_size(double mm);
@@ -241,8 +247,24 @@ class Viewer {
   void blit(const ImageRgb& image, float exposure);  // tone-mapped, stretched to the window
   void draw_difference();  // the current technique against the cached reference
   ImageRgb technique_image() const;  // the current technique's last image, window size
-  void draw_material_controls();
+  void draw_material_controls();     // colour and mean free path, or the coefficients
+  void draw_coefficient_controls(materials::Material& m, bool& changed);
   void apply_material(const materials::Material& material);
+  void save_material(const std::string& path);  // the edited material, as a material file
+  // The frame budget (frame_budget.h): the maps' settings at the current level of the ladder made
+  // from the requested settings_, and after each measured frame the level and the resolution.
+  RenderSettings running_settings() const;
+  void budget_after_frame(Technique& t);
+  Technique* previous_maps();  // the level below, converged: shown until the current has a frame
+  void set_render_scale(float scale);
+  void apply_camera();  // the camera of the view rect at the render scale (the maps only)
+  // The part of the window the image is drawn in (GL's lower-left origin): beside the panel.
+  struct ViewRect {
+    int x = 0, y = 0, width = 1, height = 1;
+  };
+  ViewRect view_rect() const;
+  float default_panel_width() const;
+  void mark_explicit(const std::string& knob);  // a knob set by hand is kept at every level
   std::filesystem::path next_screenshot_path() const;
 
   ViewerOptions options_;
@@ -299,7 +321,30 @@ class Viewer {
   float scroll_ = 0;
   bool dragging_ = false;
   double last_x_ = 0, last_y_ = 0;
-  long frames_drawn_ = 0;
+  long frames_drawn_ = 0, frames_rendered_ = 0;
+  // The frame budget: the level of the maps' ladder, the cost model of the frames measured, the
+  // resolution while refining (1 once converged), whether the next frame is a level's first (the
+  // programs compile in it; not measured).
+  double frame_budget_ms_ = 50;
+  FixedKnobs fixed_;
+  int level_ = 0;
+  std::vector<LiveTechnique> parked_maps_;  // by level: the maps set up at the other levels
+  double layer_ms_ = 0, final_ms_ = 0;      // measured at the current level (running means)
+  RenderSettings measured_at_;              // the level layer_ms_ was measured at
+  FrameSplit split_;                        // the maps' frame split now
+  bool level_first_frame_ = true;
+  float render_scale_ = 1, refine_scale_ = 1;
+  bool redraw_ = true;                    // something changed since the last rendered frame
+  bool exposure_pending_frames_ = false;  // auto exposure waits for a few accumulated frames
+  double max_frame_ms_ = 0;  // the longest window frame after the first second (the summary)
+  double start_time_ = 0;
+  // The panel: docked at the left; its width as the person left it (0 when folded or hidden), and
+  // the widest line it holds (a label wider than the panel would be clipped).
+  float panel_width_ = 0, panel_content_width_ = 0, panel_inner_width_ = 0;
+  bool panel_collapsed_ = false;
+  float panel_bar_height_ = 0;      // the folded panel's title bar, px
+  bool edit_coefficients_ = false;  // the material in coefficients instead of colour and mfp
+  std::array<char, 512> save_path_{};
   int restarts_ = 0, screenshots_ = 0;
   double frame_ms_ = 0, last_time_ = 0;
 };

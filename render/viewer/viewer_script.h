@@ -35,7 +35,7 @@ inline std::vector<ScriptAction> parse_script(const std::string& text) {
     const std::size_t n = action.args.size();
     const bool ok = ((v == "orbit" || v == "light" || v == "set") && n == 2) ||
                     ((v == "zoom" || v == "wait" || v == "sleep" || v == "screenshot" ||
-                      v == "screenshot-panel") &&
+                      v == "screenshot-panel" || v == "save") &&
                      n == 1) ||
                     (v == "key" && n == 1 && action.args[0].size() == 1 &&
                      std::isalpha(static_cast<unsigned char>(action.args[0][0]))) ||
@@ -70,13 +70,19 @@ inline std::vector<ScriptAction> parse_script(const std::string& text) {
       if (ext != ".png")
         throw Error("--script: '" + v + " " + action.args[0] + "': expected FILE.png");
     }
+    if (ok && v == "save") {
+      std::string ext = std::filesystem::path(action.args[0]).extension().string();
+      for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+      if (ext != ".json")
+        throw Error("--script: 'save " + action.args[0] + "': expected FILE.json (a material)");
+    }
     if (!ok) {
       const auto first = item.find_first_not_of(' ');
       const auto last = item.find_last_not_of(' ');
       throw Error("--script: '" + item.substr(first, last - first + 1) +
                   "': expected orbit DX DY, light DX DY, zoom STEPS, set NAME VALUE, key LETTER, "
                   "wait FRAMES, sleep SECONDS, settle, screenshot FILE.png, screenshot-panel "
-                  "FILE.png, panel on|off, "
+                  "FILE.png, save FILE.json, panel on|off, "
                   "difference on|off, restart or quit");
     }
     actions.push_back(std::move(action));

@@ -13,13 +13,14 @@ void Viewer::set_technique(TechniqueId technique) {
   technique_ = technique;
   // Same scene, another technique: the cached reference stays valid for the difference view.
   const std::uint64_t version = scene_version_;
+  apply_camera();  // the maps may render at a reduced resolution, the others at the view's
   scene_changed();
   scene_version_ = version;
 }
 
 TechniqueOptions Viewer::technique_options() const {
   TechniqueOptions o;
-  o.settings = settings_;
+  o.settings = running_settings();  // the maps at the frame budget's level
   o.maps.time_stages = true;  // the panel shows the passes' times
   o.sh = options_.sh;
   o.hierarchical = options_.hierarchical;
@@ -79,7 +80,24 @@ void Viewer::draw_technique() {
       static_cast<FurRenderer&>(*t).set_light_sh({lobe, lobe, lobe});
       live_[std::size_t(technique_)].seen.lights = ~std::uint64_t(0);  // the scene's at next sync
     }
-    t->render_frame();
+    // Nothing is rendered once the technique has converged and nothing changed: the last image
+    // is presented again (the maps took 17 s a frame, forever, after converging).
+    const bool converged = t->converged();
+    const bool animated = deformer_ || (technique_ == TechniqueId::kFur && fur_lobe_);
+    if (!converged || redraw_ || animated) {
+      t->render_frame();
+      ++frames_rendered_;
+      redraw_ = false;
+      if (!converged) budget_after_frame(*t);
+      // Converged at a level below the requested settings: on to the next (its first image
+      // replaces this one's when it has one).
+      if (technique_ == TechniqueId::kMaps && frame_budget_ms_ > 0 && t->converged() &&
+          level_ + 1 < int(maps_quality_ladder(settings_, fixed_).size())) {
+        switch_maps_level(level_ + 1);
+        apply_camera();
+      }
+      t = &current_technique();
+    }
   } catch (const Error& e) {
     if (technique_ == TechniqueId::kMaps) throw;  // nothing to hand over to
     message_ = e.what();
@@ -88,14 +106,38 @@ void Viewer::draw_technique() {
     return;
   }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  if (auto_exposure_) {
-    settings_.exposure = pending_.exposure = auto_exposure(t->read_image());
-    auto_exposure_ = false;
+  // Converged at the refining resolution: the still at the view's own (one final pass; the
+  // radiance maps do not depend on the camera).
+  if (technique_ == TechniqueId::kMaps && t->converged() && render_scale_ < 1 && !dragging_) {
+    set_render_scale(1);
   }
+  glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT);
   if (show_difference_) {
     draw_difference();
   } else {
-    t->present(settings_.exposure, width_, height_);
+    // A level's first frame not done yet: the level below's converged image, brought to the view.
+    Technique* shown = t;
+    if (technique_ == TechniqueId::kMaps && t->frame_stats().frames == 0) {
+      if (Technique* previous = previous_maps()) {
+        LiveTechnique& slot = parked_maps_[std::size_t(level_ - 1)];
+        if (slot.seen.camera != versions_.camera) {
+          sync(slot);
+          previous->render_frame();  // converged: the final pass alone
+          glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        }
+        shown = previous;
+      }
+    }
+    // Auto exposure (a new material or light, E): from the image shown once it has settled a
+    // little (converged, or four frames).
+    if (auto_exposure_ && (shown->converged() || !technique_info(technique_).frame_snapshots ||
+                           shown->frame_stats().frames >= 4)) {
+      settings_.exposure = pending_.exposure = auto_exposure(shown->read_image());
+      auto_exposure_ = false;
+    }
+    const ViewRect r = view_rect();
+    shown->present(settings_.exposure, r.x, r.y, r.width, r.height);
   }
 }
 
@@ -132,7 +174,9 @@ void Viewer::draw_difference() {
         "no CPU image of this view: switch to the reference or the path tracer, let it run a "
         "pass, come back";
     const Technique* t = live(technique_);
-    (t != nullptr ? t : live(TechniqueId::kMaps))->present(settings_.exposure, width_, height_);
+    const ViewRect r = view_rect();
+    (t != nullptr ? t : live(TechniqueId::kMaps))
+        ->present(settings_.exposure, r.x, r.y, r.width, r.height);
     return;
   }
   // The technique's image averaged 2 x 2 down to the reference's half resolution.
@@ -212,8 +256,9 @@ void Viewer::blit(const ImageRgb& mean, float exposure) {
   }
   if (reference_fbo_ != 0) {
     // Row 0 of the image is the top: flip while blitting.
-    glBlitNamedFramebuffer(reference_fbo_, 0, 0, 0, reference_w_, reference_h_, 0, height_, width_,
-                           0, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+    const ViewRect r = view_rect();
+    glBlitNamedFramebuffer(reference_fbo_, 0, 0, 0, reference_w_, reference_h_, r.x, r.y + r.height,
+                           r.x + r.width, r.y, GL_COLOR_BUFFER_BIT, GL_LINEAR);
   }
 }
 

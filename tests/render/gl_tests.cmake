@@ -7,6 +7,9 @@ lucent_add_test(glsl_twin_test
 lucent_add_test(radiance_maps_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/radiance_maps_test.cpp
   LIBS lucent::render lucent::materials OpenGL::OpenGL)
+lucent_add_test(radiance_maps_split_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/radiance_maps_split_test.cpp
+  LIBS lucent::render lucent::materials OpenGL::OpenGL)
 lucent_add_test(faceted_mesh_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/faceted_mesh_test.cpp
   LIBS lucent::render lucent::materials OpenGL::OpenGL)
@@ -36,7 +39,8 @@ lucent_add_test(oblique_skew_test
   LIBS lucent::render lucent::materials OpenGL::OpenGL)
 # White-box: both include private headers of render/ (gl_program.h, gl_bssrdf.h,
 # radiance_maps_sampling.h).
-foreach(t glsl_twin_test geometry_factor_test oblique_skew_test radiance_maps_test sh_renderer_test area_light_test fur_glsl_twin_test
+foreach(t glsl_twin_test geometry_factor_test oblique_skew_test radiance_maps_test
+          radiance_maps_split_test sh_renderer_test area_light_test fur_glsl_twin_test
           fur_renderer_test)
   target_include_directories(${t} PRIVATE ${LUCENT_RENDER_PRIVATE_DIRS})
 endforeach()

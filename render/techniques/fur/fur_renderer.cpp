@@ -245,8 +245,8 @@ void FurRenderer::set_light_sh(const std::array<ShVector<double>, 3>& light) {
   impl_->upload_sh(light);
 }
 
-void FurRenderer::present(float exposure, int width, int height) const {
-  impl_->final.present(exposure, width, height);
+void FurRenderer::present(float exposure, int x, int y, int width, int height) const {
+  impl_->final.present(exposure, x, y, width, height);
 }
 
 bool FurRenderer::render_frame() {

@@ -253,8 +253,8 @@ std::vector<std::uint8_t> HierarchicalRenderer::read_mask() const {
   return impl_->final.read_mask();
 }
 
-void HierarchicalRenderer::present(float exposure, int width, int height) const {
-  impl_->final.present(exposure, width, height);
+void HierarchicalRenderer::present(float exposure, int x, int y, int width, int height) const {
+  impl_->final.present(exposure, x, y, width, height);
 }
 
 const hierarchical::Stats& HierarchicalRenderer::stats() const {

@@ -444,18 +444,19 @@ void RadianceMapRenderer::Impl::render_radiance_depth() {
   glProgramUniform1i(radiance_program.id(), radiance_program.location("u_depth_only"), 0);
 }
 
-void RadianceMapRenderer::Impl::render_radiance() {
+void RadianceMapRenderer::Impl::render_radiance(int t, int first, int count) {
   // Frame t (1-based) writes buffer t % 2 and reads the sum so far from the other (seed §5.3.3).
-  const int t = frame;
   const int target = t % 2, previous = 1 - target;
-  if (options.new_radii_each_frame || settings.disc_selection == DiscSelection::kStrata) {
-    upload_disc(t, false);
-  }
   const int W = settings.radiance_map_size;
+  if (first == 0) {
+    if (options.new_radii_each_frame || settings.disc_selection == DiscSelection::kStrata) {
+      upload_disc(t, false);
+    }
+    const float zero[4] = {0, 0, 0, 0};
+    glClearNamedFramebufferfv(radiance_fbo[target].id(), GL_COLOR, 0, zero);
+  }
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, radiance_fbo[target].id());
   glViewport(0, 0, W, W);
-  const float zero[4] = {0, 0, 0, 0};
-  glClearNamedFramebufferfv(radiance_fbo[target].id(), GL_COLOR, 0, zero);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LEQUAL);
   glDepthMask(GL_FALSE);
@@ -479,9 +480,23 @@ void RadianceMapRenderer::Impl::render_radiance() {
     glBindTextureUnit(kUnitTabulated, tabulated_rows.id());
     glBindSampler(kUnitTabulated, nearest.id());
   }
-  mesh.draw_instanced(K);
+  const GLint first_layer = radiance_program.location("u_first_layer");
+  if (bands == 1) {
+    glProgramUniform1i(p, first_layer, first);  // a run of whole layers, one instanced draw
+    mesh.draw_instanced(count);
+  } else {
+    // One layer at a time, its rows in bands: the rasteriser skips what the scissor leaves out.
+    glEnable(GL_SCISSOR_TEST);
+    for (int u = first; u < first + count; ++u) {
+      const int band = u % bands, y0 = band * W / bands, y1 = (band + 1) * W / bands;
+      glScissor(0, y0, W, y1 - y0);
+      glProgramUniform1i(p, first_layer, u / bands);
+      mesh.draw_instanced(1);
+    }
+    glDisable(GL_SCISSOR_TEST);
+  }
+  glProgramUniform1i(p, first_layer, 0);
   glDepthMask(GL_TRUE);
-  current = target;
 }
 
 void RadianceMapRenderer::Impl::render_blur() {

@@ -60,6 +60,7 @@ void RadianceMapRenderer::restart() {
   Impl& m = *impl_;
   m.frame = 0;
   m.level = 0;
+  m.next_unit = 0;
   m.light_map_valid = false;
   m.last_image.clear();
   const std::string renderer = m.stats.gl_renderer;
@@ -76,21 +77,34 @@ void RadianceMapRenderer::restart() {
 
 bool RadianceMapRenderer::render_frame() {
   Impl& m = *impl_;
-  const bool accumulating = m.frame < m.settings.frames;
-  if (accumulating && m.has_area_lights()) {
-    // Each accumulated frame sees the area lights from new points of their polygons.
-    m.upload_light_cameras(m.frame + 1);
-    m.light_map_valid = false;
+  const bool accumulate = m.frame < m.settings.frames;
+  if (accumulate && m.next_unit == 0) {
+    if (m.has_area_lights()) {
+      // Each accumulated frame sees the area lights from new points of their polygons.
+      m.upload_light_cameras(m.frame + 1);
+      m.light_map_valid = false;
+    }
   }
   if (!m.light_map_valid) {
     m.timed(kLightMap, [&] { m.render_light_map(); });
     m.light_map_valid = true;
     ++m.stats.light_map_renders;
   }
-  const bool accumulate = m.frame < m.settings.frames;
+  m.last_call_units = 0;
   if (accumulate) {
+    const int total = m.K * m.bands;
+    const int count = m.units_per_call > 0 ? std::min(m.units_per_call, total - m.next_unit)
+                                           : total - m.next_unit;
+    m.timed(kRadianceMap, [&] { m.render_radiance(m.frame + 1, m.next_unit, count); });
+    m.last_call_units = count;
+    m.next_unit += count;
+    if (m.next_unit < total) {
+      gl::check_errors("a part of a radiance-map frame");
+      return true;  // the frame goes on at the next call; the last final image stays
+    }
+    m.next_unit = 0;
     ++m.frame;
-    m.timed(kRadianceMap, [&] { m.render_radiance(); });
+    m.current = m.frame % 2;
     m.level = detail::blur_level_for_frame(m.frame, m.settings.frames,
                                            std::min(m.options.max_blur_level, m.levels - 1));
     m.timed(kMipBlur, [&] { m.render_blur(); });
@@ -101,6 +115,24 @@ bool RadianceMapRenderer::render_frame() {
   if (accumulate && m.options.convergence_tolerance > 0) m.record_convergence();
   gl::check_errors("a radiance-map frame");
   return accumulate;
+}
+
+void RadianceMapRenderer::set_split(int bands, int units_per_call) {
+  Impl& m = *impl_;
+  if (bands < 1 || units_per_call < 0) throw std::logic_error("set_split: bands >= 1, units >= 0");
+  if (bands != m.bands) {
+    m.bands = bands;
+    m.next_unit = 0;  // a frame begun in other bands starts again
+  }
+  m.units_per_call = units_per_call;
+}
+
+int RadianceMapRenderer::last_call_units() const {
+  return impl_->last_call_units;
+}
+
+bool RadianceMapRenderer::frame_in_progress() const {
+  return impl_->next_unit > 0;
 }
 
 int RadianceMapRenderer::accumulated_frames() const {
@@ -121,9 +153,9 @@ std::vector<std::uint8_t> RadianceMapRenderer::read_mask() const {
   return m.final.read_mask();
 }
 
-void RadianceMapRenderer::present(float exposure, int width, int height) const {
+void RadianceMapRenderer::present(float exposure, int x, int y, int width, int height) const {
   const Impl& m = *impl_;
-  m.final.present(exposure, width, height);
+  m.final.present(exposure, x, y, width, height);
 }
 
 const RadianceMapStats& RadianceMapRenderer::stats() const {
@@ -159,6 +191,48 @@ FrameStats RadianceMapRenderer::frame_stats() const {
   return f;
 }
 
+void fill_render_stats(const RadianceMapRenderer& renderer, const Scene& scene,
+                       const RenderSettings& settings, const RadianceMapOptions& options,
+                       double total_ms, RenderStats& stats) {
+  const RadianceMapStats& s = renderer.stats();
+  const StageTimes wall = s.mean_wall(), gpu = s.mean_gpu();
+  stats.technique = "maps";
+  stats.width = scene.camera.width;
+  stats.height = scene.camera.height;
+  stats.total_ms = total_ms;
+  stats.pass_ms = {{"setup", s.setup_ms},
+                   {"light map", wall.light_map_ms},
+                   {"radiance map", wall.radiance_map_ms},
+                   {"mip blur", wall.mip_blur_ms},
+                   {"final", wall.final_ms}};
+  stats.details = {
+      {"gl_renderer", s.gl_renderer},
+      {"timing", options.time_stages ? "per-frame means, glFinish + wall clock"
+                                     : "per-frame means, wall clock without glFinish"},
+      {"gpu_query_ms",
+       {{"light map", gpu.light_map_ms},
+        {"radiance map", gpu.radiance_map_ms},
+        {"mip blur", gpu.mip_blur_ms},
+        {"final", gpu.final_ms}}},
+      {"frames", s.frames},
+      {"convergence_frame", s.convergence_frame},
+      {"convergence_tolerance", options.convergence_tolerance},
+      {"frame_change", s.frame_change},
+      {"uncovered_fraction", s.uncovered_fraction},
+      // The final pass's quadrature of Jensen's single scattering (single_scattering.glsl).
+      {"single_scattering", scene.single_scattering},
+      {"single_scattering_steps", scene.single_scattering ? detail::kSingleScatteringSteps : 0},
+      {"angular", scene.angular && materials::angular_factor_applies(settings.model)},
+      {"geometry_factor",
+       scene.geometry_factor && materials::geometry_factor_applies(settings.model)},
+      {"sigma_star_per_mm", s.sigma_star_per_mm},
+      {"disc_radius_mm", s.disc_radius_mm},
+      {"used_disc_radius_mm", s.used_disc_radius_mm},
+      {"samples_per_light", s.samples_per_light},
+      {"settings", settings.to_string()},
+      {"options", options.to_string()}};
+}
+
 ImageRgb render_radiance_maps(const Scene& scene, const RenderSettings& settings,
                               RenderStats* stats) {
   return render_radiance_maps(scene, settings, RadianceMapOptions{}, stats, nullptr);
@@ -173,53 +247,16 @@ ImageRgb render_radiance_maps(const Scene& scene, const RenderSettings& settings
   renderer.setup(scene, settings, options);
   while (renderer.render_frame()) {
     const int t = renderer.accumulated_frames();
-    if (options.on_snapshot && std::find(options.snapshot_frames.begin(),
-                                         options.snapshot_frames.end(), t) !=
-                                   options.snapshot_frames.end()) {
+    if (options.on_snapshot &&
+        std::find(options.snapshot_frames.begin(), options.snapshot_frames.end(), t) !=
+            options.snapshot_frames.end()) {
       options.on_snapshot(t, renderer.read_image());
     }
   }
   ImageRgb image = renderer.read_image();
-  const RadianceMapStats& s = renderer.stats();
-  if (details != nullptr) *details = s;
-  if (stats != nullptr) {
-    const StageTimes wall = s.mean_wall(), gpu = s.mean_gpu();
-    stats->technique = "maps";
-    stats->width = scene.camera.width;
-    stats->height = scene.camera.height;
-    stats->total_ms = now_ms() - t0;
-    stats->pass_ms = {{"setup", s.setup_ms},
-                      {"light map", wall.light_map_ms},
-                      {"radiance map", wall.radiance_map_ms},
-                      {"mip blur", wall.mip_blur_ms},
-                      {"final", wall.final_ms}};
-    stats->details = {
-        {"gl_renderer", s.gl_renderer},
-        {"timing", options.time_stages ? "per-frame means, glFinish + wall clock"
-                                       : "per-frame means, wall clock without glFinish"},
-        {"gpu_query_ms",
-         {{"light map", gpu.light_map_ms},
-          {"radiance map", gpu.radiance_map_ms},
-          {"mip blur", gpu.mip_blur_ms},
-          {"final", gpu.final_ms}}},
-        {"frames", s.frames},
-        {"convergence_frame", s.convergence_frame},
-        {"convergence_tolerance", options.convergence_tolerance},
-        {"frame_change", s.frame_change},
-        {"uncovered_fraction", s.uncovered_fraction},
-        // The final pass's quadrature of Jensen's single scattering (single_scattering.glsl).
-        {"single_scattering", scene.single_scattering},
-        {"single_scattering_steps", scene.single_scattering ? detail::kSingleScatteringSteps : 0},
-        {"angular", scene.angular && materials::angular_factor_applies(settings.model)},
-        {"geometry_factor",
-         scene.geometry_factor && materials::geometry_factor_applies(settings.model)},
-        {"sigma_star_per_mm", s.sigma_star_per_mm},
-        {"disc_radius_mm", s.disc_radius_mm},
-        {"used_disc_radius_mm", s.used_disc_radius_mm},
-        {"samples_per_light", s.samples_per_light},
-        {"settings", settings.to_string()},
-        {"options", options.to_string()}};
-  }
+  if (details != nullptr) *details = renderer.stats();
+  if (stats != nullptr)
+    fill_render_stats(renderer, scene, settings, options, now_ms() - t0, *stats);
   return image;
 }
 

@@ -98,6 +98,9 @@ struct RadianceMapRenderer::Impl {
   int frame = 0;    // accumulated
   int current = 0;  // ping-pong buffer holding the latest sum
   int level = 0;    // blur level of the last final pass
+  // A frame split across render_frame calls (set_split): each layer in `bands` bands of rows,
+  // `units_per_call` layer-bands a call (0: the whole frame), the next one to render.
+  int bands = 1, units_per_call = 0, next_unit = 0, last_call_units = 0;
   bool light_map_valid = false;
   bool programs_have_area_lights = false;  // compiled with LUCENT_AREA_LIGHTS
   std::vector<float> last_image;
@@ -119,7 +122,8 @@ struct RadianceMapRenderer::Impl {
   void upload_layers();
   void render_light_map();
   void render_radiance_depth();
-  void render_radiance();
+  /// Layer-bands [first, first + count) of frame t (t % 2 the buffer written; the first clears it).
+  void render_radiance(int t, int first, int count);
   void render_blur();
   void render_final();
   template <typename F>

@@ -113,8 +113,8 @@ std::vector<float> ShRenderer::read_cube_map() const {
   return rgba;
 }
 
-void ShRenderer::present(float exposure, int width, int height) const {
-  impl_->final.present(exposure, width, height);
+void ShRenderer::present(float exposure, int x, int y, int width, int height) const {
+  impl_->final.present(exposure, x, y, width, height);
 }
 
 const ShStats& ShRenderer::stats() const {

@@ -63,7 +63,7 @@ class FurRenderer final : public Technique {
   void set_material(const materials::Material& material) override;
   /// 1 where the shells or the skin cover a pixel (alpha > 0).
   std::vector<std::uint8_t> read_mask() const override;
-  void present(float exposure, int width, int height) const override;
+  void present(float exposure, int x, int y, int width, int height) const override;
   bool render_frame() override;  ///< always true
   ImageRgb read_image() const override;
   double precompute_ms() const;  ///< the tile's hairs, cross-sections and transfer

@@ -42,7 +42,7 @@ class HierarchicalRenderer final : public Technique {
 
   ImageRgb read_image() const override;                  ///< linear RGB, row 0 at the top
   std::vector<std::uint8_t> read_mask() const override;  ///< 1 where a pixel sees the object
-  void present(float exposure, int width, int height) const override;
+  void present(float exposure, int x, int y, int width, int height) const override;
 
   const hierarchical::Stats& stats() const;  ///< the solve's, last frame
   double upload_ms() const;         ///< last frame's B upload

@@ -128,15 +128,24 @@ class RadianceMapRenderer final : public Technique {
   /// accumulated, then the final pass. Returns true if it accumulated a frame.
   bool render_frame() override;
   int accumulated_frames() const;
-  bool converged() const override;  ///< T frames accumulated: further frames change nothing
+  bool converged() const override;
+  /// Splits each frame across calls of render_frame (the viewer's frame budget): every layer in
+  /// `bands` bands of rows (1: whole layers), `units_per_call` layer-bands a call (0: the whole
+  /// frame at once, the default). A call that does not finish the frame renders no final image
+  /// (the last one stays); the frame's image is the same as unsplit. Changing `bands` restarts the
+  /// frame in progress.
+  void set_split(int bands, int units_per_call);
+  int last_call_units() const;     ///< layer-bands the last call rendered (0: none)
+  bool frame_in_progress() const;  ///< a split frame has begun and not finished  ///< T frames
+                                   ///< accumulated: further frames change nothing
 
   /// The last final pass: linear RGB radiance, camera.width x camera.height, row 0 at the top.
   ImageRgb read_image() const override;
   /// width * height: 1 where a pixel sees the object, 0 elsewhere (as ReferenceImage::mask).
   std::vector<std::uint8_t> read_mask() const override;
   /// Draws the last final image tone-mapped (exposure, Reinhard, sRGB) into the currently bound
-  /// draw framebuffer over width x height pixels (the window of `lucent view`).
-  void present(float exposure, int width, int height) const override;
+  /// draw framebuffer over the width x height pixels from (x, y) (the window of `lucent view`).
+  void present(float exposure, int x, int y, int width, int height) const override;
 
   const RadianceMapStats& stats() const;
   /// The last frame's passes (wall clock) and the disc it used.
@@ -156,5 +165,36 @@ ImageRgb render_radiance_maps(const Scene& scene, const RenderSettings& settings
 ImageRgb render_radiance_maps(const Scene& scene, const RenderSettings& settings,
                               const RadianceMapOptions& options, RenderStats* stats,
                               RadianceMapStats* details = nullptr);
+
+/// The same as the last RenderStats of render_radiance_maps: pass means and the details, for a
+/// renderer that has run its frames.
+void fill_render_stats(const RadianceMapRenderer& renderer, const Scene& scene,
+                       const RenderSettings& settings, const RadianceMapOptions& options,
+                       double total_ms, RenderStats& stats);
+
+/// `lucent render`'s maps within a time budget per image (frame_budget.h): the first level of
+/// `ladder` (the coarse image) and then, level after level, the highest one whose setup and frames
+/// are predicted (from the frames measured so far) to fit what is left of `budget_s`, until the
+/// last level (the requested settings) has been rendered or no higher level fits.
+struct BudgetedMapsOptions {
+  std::vector<RenderSettings> ladder;  ///< maps_quality_ladder(requested, fixed)
+  double budget_s = 0;                 ///< per image, s; infinity: up to the requested settings
+  /// Called with each level's image that a higher level will refine (the first is the coarse
+  /// one); the last level's image is the result.
+  std::function<void(const ImageRgb& image, int level)> on_image;
+  /// The share of the planned work done and the seconds the plan still predicts.
+  std::function<void(double fraction, double left_s)> progress;
+};
+struct BudgetedMaps {
+  ImageRgb image;                     ///< the last level rendered
+  int level = 0;                      ///< its index in the ladder
+  std::vector<double> level_seconds;  ///< wall clock of each level run, in order
+  std::vector<int> levels_run;        ///< their indices
+  double requested_frame_ms = 0;      ///< the cost model's prediction for a requested frame
+};
+BudgetedMaps render_radiance_maps_within_budget(const Scene& scene,
+                                                const RadianceMapOptions& options,
+                                                const BudgetedMapsOptions& budget,
+                                                RenderStats* stats);
 
 }  // namespace lucent::render

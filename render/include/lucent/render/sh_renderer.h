@@ -122,7 +122,7 @@ class ShRenderer final : public Technique {
   /// The last cube map: 6 faces of cube_map_size^2 RGBA texels, face-major, rows from t = 0.
   std::vector<float> read_cube_map() const;
   /// The tone-mapped last image into the bound draw framebuffer (the viewer).
-  void present(float exposure, int width, int height) const override;
+  void present(float exposure, int x, int y, int width, int height) const override;
 
   const ShStats& stats() const;
 

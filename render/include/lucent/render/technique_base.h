@@ -68,8 +68,9 @@ class Technique {
   /// width * height: 1 where a pixel sees the object.
   virtual std::vector<std::uint8_t> read_mask() const = 0;
   /// The last frame tone-mapped (exposure, Reinhard, sRGB) into the bound draw framebuffer over
-  /// width x height pixels.
-  virtual void present(float exposure, int width, int height) const = 0;
+  /// the width x height pixels from (x, y) (GL's viewport: the lower left corner), stretched to
+  /// them when the frame was rendered at another size (the viewer's reduced resolution).
+  virtual void present(float exposure, int x, int y, int width, int height) const = 0;
 
   virtual FrameStats frame_stats() const = 0;
   std::string to_string() const { return frame_stats().to_string(); }

@@ -26,6 +26,15 @@ float tone_curve(float x);
 /// The sRGB transfer function (IEC 61966-2-1) on [0, 1]; values outside are clamped.
 float srgb_encode(float linear);
 
+/// Its inverse on [0, 1] (values outside clamped).
+float srgb_decode(float encoded);
+
+/// What a screen shows, as linear light in [0, 1]: a render after the exposure and the tone curve
+/// (before the sRGB encoding), or a PNG's codes decoded. `lucent compare` holds a PNG against an
+/// EXR, or two PNGs, in this space.
+imaging::ImageRgb displayed(const imaging::ImageRgb& linear, const ToneMapOptions& options);
+imaging::ImageRgb displayed(const imaging::RawImage& png);
+
 /// exposure -> tone_curve -> srgb_encode -> 8-bit RGB (rounded).
 imaging::RawImage tone_map(const imaging::ImageRgb& linear, const ToneMapOptions& options = {});
 

@@ -7,13 +7,18 @@
 //
 // Controls: left drag orbits, the wheel zooms, right drag moves the selected light around the
 // object; S saves a screenshot (lucent_view_NNN.png in the working folder), R restarts the
-// accumulation, H hides the panel, Esc quits. The panel has the material (library or file, the
-// file reloaded when it changes), the technique and model, sliders for N, M, q, K, W_s, W_l, T,
-// exposure and object size, the sine deformer, per-stage times and the accumulated frames.
+// accumulation, H hides the panel, E sets the exposure from the image, Esc quits. The panel (docked
+// at the left, the image beside it; resizable, foldable) has the material (library or file, the
+// file reloaded when it changes; its colour and mean free path, or its coefficients, edited and
+// saved), the technique and model, sliders for N, M, q, K, W_s, W_l, T, exposure and object size,
+// the sine deformer, per-stage times, the accumulated frames and the quality the frame budget
+// chose. Input and the panel are handled every frame; frames are kept within the frame budget
+// while the maps refine, and nothing is rendered once they have converged.
 #pragma once
 
 #include <string>
 
+#include "lucent/render/frame_budget.h"
 #include "lucent/render/fur.h"
 #include "lucent/render/hierarchical.h"
 #include "lucent/render/reference_renderer.h"
@@ -55,6 +60,12 @@ struct ViewerOptions {
   ///   screenshot FILE.png | restart | quit
   std::string script;
   bool hide_panel = false;     ///< --hide-panel: start without the panel (H toggles it)
+  /// --frame-budget-ms: the maps' knobs not in `fixed` are chosen per frame from the quality
+  /// ladder (frame_budget.h) so that a frame takes about this long, and the image is rendered at
+  /// a reduced resolution while it refines when even the coarsest level's frame is over it;
+  /// 0: the knobs as given, whatever a frame costs.
+  double frame_budget_ms = 50;
+  FixedKnobs fixed;            ///< the maps' knobs given on the command line (and then the panel's)
   bool auto_exposure = false;  ///< --exposure auto: set once from the first images (tone_map.h)
 };
 

@@ -8,8 +8,12 @@ out vec3 v_position;
 out vec3 v_normal;
 flat out int v_layer;
 
+// The first layer of this draw: a frame split across calls (the viewer's frame budget) draws a
+// run of layers, or one layer at a time in bands, each from its own layer.
+uniform int u_first_layer = 0;
+
 void main() {
   v_position = a_position;
   v_normal = a_normal;
-  v_layer = gl_InstanceID;
+  v_layer = u_first_layer + gl_InstanceID;
 }

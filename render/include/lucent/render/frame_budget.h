@@ -1,0 +1,135 @@
+// Quality that fits a time budget: the radiance maps' knobs (K, W_s, W_l, N, T) chosen from what
+// frames measurably cost on the machine that runs them. `lucent render` takes a budget per image:
+// a first coarse image early, then the highest quality level whose predicted time fits what is
+// left of the budget (the requested settings exactly when they fit, so that the refined image is
+// the one the explicit settings give). `lucent view` takes a budget per frame: it climbs the same
+// levels one after another as each converges, every frame split across display refreshes so that
+// none takes longer than the budget.
+//
+// No clock and no OpenGL here: the callers measure (wall clock, glFinish) and say what a frame at
+// a level took, so that tests drive the planner with a fake clock.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "lucent/render/render_settings.h"
+
+namespace lucent::render {
+
+/// The maps' knobs the user gave: kept at every level (explicit knobs win over the budget).
+struct FixedKnobs {
+  bool frames = false, directions = false, samples = false, radiance_map = false, light_map = false;
+  bool all() const { return frames && directions && samples && radiance_map && light_map; }
+};
+
+/// The maps' quality levels for `requested`, coarsest first; the last is `requested` itself. Each
+/// level scales the knobs not in `fixed` down from the requested values (K to 1/4, W_s to 1/8,
+/// W_l to 1/4, N to 1/6 and T to 2 frames at level 0); levels that come out equal are merged.
+/// One level when every knob is fixed.
+std::vector<RenderSettings> maps_quality_ladder(const RenderSettings& requested,
+                                                const FixedKnobs& fixed);
+
+/// What a frame at some level cost, by pass (ms, wall clock after glFinish).
+struct MeasuredFrame {
+  RenderSettings settings;
+  int pixels = 0;          ///< the image's width x height
+  int lights = 1;          ///< light maps rendered (one per light)
+  double radiance_ms = 0;  ///< the radiance-map pass (K layers, W_s^2 texels, N gathers each)
+  double light_ms = 0;     ///< the light maps (L maps of W_l^2)
+  double final_ms = 0;     ///< the final pass and the rest of the frame (K lookups per pixel)
+};
+
+/// ms = a + b x fitted to measured (x, ms) pairs (one point per amount of work, 16 at most, each a
+/// running mean): least squares once two amounts of work 1.5x apart have been measured; before
+/// that, and where the fit comes out negative, b x through the origin with the largest measured
+/// ratio, which over-predicts a larger x (the safe side of a budget).
+class AffineCost {
+ public:
+  void record(double x, double ms);
+  double predict(double x) const;
+  bool empty() const { return samples_.empty(); }
+
+ private:
+  static constexpr std::size_t kKept = 16;
+  std::vector<std::pair<double, double>> samples_;
+};
+
+/// What a frame costs from what measured frames cost: the radiance map per layer against its
+/// texels times gathers (W_s^2 N), the light maps per light against W_l^2, the final pass (and the
+/// rest of the frame) against pixels times layers.
+class FrameCostModel {
+ public:
+  void record(const MeasuredFrame& frame);
+  bool measured() const { return frames_ > 0; }
+  /// Predicted ms of one accumulated frame of `s` at `pixels` with `lights` light maps.
+  double frame_ms(const RenderSettings& s, int pixels, int lights) const;
+
+ private:
+  AffineCost radiance_, light_, final_;
+  int frames_ = 0;
+};
+
+/// The image budget's plan for `lucent render`: which level to refine to after the coarse one.
+struct ImagePlan {
+  int level = 0;           ///< index into the ladder (its last is the requested settings)
+  double predicted_s = 0;  ///< the refinement's predicted time (setup and every frame)
+};
+
+/// The highest level whose setup (`setup_s`, measured on the coarse level) and T frames fit in
+/// `left_s`; level 0 (nothing to refine) when none above it does. `left_s` may be infinite (no
+/// budget): then the last level.
+ImagePlan plan_image(const std::vector<RenderSettings>& ladder, const FrameCostModel& cost,
+                     int pixels, int lights, double setup_s, double left_s);
+
+/// What the image budget drives: one level's set-up and its frames (render_radiance_maps_within_
+/// budget runs the radiance maps; tests run a fake machine on a fake clock).
+class BudgetLevelRunner {
+ public:
+  virtual ~BudgetLevelRunner() = default;
+  /// Sets a level up (a renderer of `settings`).
+  virtual void start(const RenderSettings& settings) = 0;
+  /// One frame; false when the level had converged (no frame accumulated). Fills what it cost.
+  virtual bool frame(MeasuredFrame& measured) = 0;
+  /// The level's frames are done; `refined_next`: a higher level follows (its image is a preview).
+  virtual void level_done(int level, bool refined_next) = 0;
+};
+
+struct ImageBudgetRun {
+  int level = 0;                      ///< the last level run (the image's)
+  std::vector<int> levels_run;        ///< in order
+  std::vector<double> level_seconds;  ///< each one's set-up and frames, s
+  double requested_frame_ms = 0;      ///< the cost model's prediction of a requested frame
+};
+
+/// The image budget: level 0, then while a higher level is predicted to fit what is left of
+/// `budget_s` (infinity: up to the last), the highest such. A level's first frame compiles its
+/// programs and is not measured. `now_s`: the clock (s); `progress(share, seconds left)` after
+/// every frame.
+ImageBudgetRun run_image_budget(const std::vector<RenderSettings>& ladder, double budget_s,
+                                int pixels, int lights, const std::function<double()>& now_s,
+                                BudgetLevelRunner& runner,
+                                const std::function<void(double, double)>& progress = {});
+
+/// How `lucent view` splits a maps frame across display refreshes (RadianceMapRenderer::set_split)
+/// so that each refresh's work stays within `budget_ms`: each layer in bands (a power of two, at
+/// most 64) of at most half the budget, and as many layer-bands a call as fit after `other_ms`
+/// (the light map and the final pass of a call that ends a frame). The whole frame in one call
+/// (units 0) when it fits. `layer_ms`: one layer's radiance-map pass, measured or predicted.
+struct FrameSplit {
+  int bands = 1;
+  int units_per_call = 0;  ///< 0: the whole frame
+};
+FrameSplit plan_split(double layer_ms, int layers, double other_ms, double budget_ms);
+
+/// A layer's radiance-map time at `to` predicted from one measured at `from`: in proportion to the
+/// texels times gathers (W_s^2 N), which over-predicts a larger level (its fixed part is smaller).
+double predict_layer_ms(double layer_ms, const RenderSettings& from, const RenderSettings& to);
+
+/// "K 16, W_s 512, W_l 512, N 50, T 100": a level in the flags' letters, for summaries.
+std::string quality_text(const RenderSettings& s);
+
+}  // namespace lucent::render

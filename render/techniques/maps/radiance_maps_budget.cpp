@@ -1,0 +1,76 @@
+// The radiance maps within a time budget per image (radiance_maps.h): run_image_budget
+// (frame_budget.h) driving a RadianceMapRenderer per level.
+#include <chrono>
+#include <memory>
+
+#include "lucent/render/frame_budget.h"
+#include "lucent/render/gl_context.h"
+#include "lucent/render/radiance_maps.h"
+#include "radiance_maps_impl.h"
+
+namespace lucent::render {
+namespace {
+
+class MapsLevelRunner final : public BudgetLevelRunner {
+ public:
+  MapsLevelRunner(const Scene& scene, const RadianceMapOptions& options,
+                  const BudgetedMapsOptions& budget)
+      : scene_(scene), options_(options), budget_(budget) {}
+
+  void start(const RenderSettings& settings) override {
+    renderer_ = std::make_unique<RadianceMapRenderer>();  // the previous level's is released
+    renderer_->setup(scene_, settings, options_);
+    settings_ = settings;
+  }
+  bool frame(MeasuredFrame& m) override {
+    if (!renderer_->render_frame()) return false;
+    for (const auto& [name, ms] : renderer_->frame_stats().pass_ms) {
+      if (name == "radiance map") {
+        m.radiance_ms = ms;
+      } else if (name == "light map") {
+        m.light_ms = ms;
+      } else {
+        m.final_ms += ms;
+      }
+    }
+    return true;
+  }
+  void level_done(int level, bool refined_next) override {
+    if (refined_next && budget_.on_image) budget_.on_image(renderer_->read_image(), level);
+  }
+  const RadianceMapRenderer& renderer() const { return *renderer_; }
+  const RenderSettings& settings() const { return settings_; }
+
+ private:
+  const Scene& scene_;
+  const RadianceMapOptions& options_;
+  const BudgetedMapsOptions& budget_;
+  std::unique_ptr<RadianceMapRenderer> renderer_;
+  RenderSettings settings_;
+};
+
+}  // namespace
+
+BudgetedMaps render_radiance_maps_within_budget(const Scene& scene,
+                                                const RadianceMapOptions& options,
+                                                const BudgetedMapsOptions& budget,
+                                                RenderStats* stats) {
+  const double t0 = now_ms();
+  const auto context = GlContext::create_headless();
+  MapsLevelRunner runner(scene, options, budget);
+  const ImageBudgetRun run = run_image_budget(
+      budget.ladder, budget.budget_s, scene.camera.width * scene.camera.height,
+      int(scene.lights.size()), [] { return now_ms() / 1000; }, runner, budget.progress);
+  BudgetedMaps result;
+  result.level = run.level;
+  result.levels_run = run.levels_run;
+  result.level_seconds = run.level_seconds;
+  result.requested_frame_ms = run.requested_frame_ms;
+  result.image = runner.renderer().read_image();
+  if (stats != nullptr) {
+    fill_render_stats(runner.renderer(), scene, runner.settings(), options, now_ms() - t0, *stats);
+  }
+  return result;
+}
+
+}  // namespace lucent::render

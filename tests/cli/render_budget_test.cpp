@@ -1,0 +1,128 @@
+// `lucent render --budget` (cli/render_command.cpp, render/core/frame_budget.cpp) end to end on
+// this machine's OpenGL: the coarse first image, progress away from a terminal, PNG and EXR from
+// one run, and the refined image equal to the one the explicit settings give.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.h"
+
+namespace lucent::testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kScene =
+    "render --material marble --mesh sphere --light directional:1,0.5,1:1,1,1 --view 30,20,4 ";
+
+double relative_rmse(const fs::path& a, const fs::path& b) {
+  const auto c =
+      run_lucent("compare \"" + a.string() + "\" \"" + b.string() + "\" --json", "compare");
+  EXPECT_EQ(c.exit_code, 0) << c.err;
+  return c.exit_code == 0 ? nlohmann::json::parse(c.out).at("relative_rmse").get<double>() : -1;
+}
+
+// A budget far below the seed's settings on a CPU: the coarse image first, a line per tenth of
+// progress on stderr (ctest's pipe is not a terminal), PNG and EXR both written, and the stats say
+// which quality the budget bought against the requested one.
+TEST(RenderBudget, CoarseFirstThenRefinedWithProgressAndBothImages) {
+  const auto dir = scratch_dir("render-budget");
+  const fs::path png = dir / "b.png", exr = dir / "b.exr", stats = dir / "b.json";
+  // W_s and T given: the budget scales K, N and W_l under them (a level of a few seconds fits).
+  const auto r = run_lucent(kScene +
+                                "--size 48x48 --maps-radiance-map 128 --maps-frames 4 "
+                                "--budget 8 -o \"" +
+                                png.string() + "\" -o \"" + exr.string() + "\" --stats \"" +
+                                stats.string() + "\"",
+                            "budget");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(png));
+  EXPECT_TRUE(fs::exists(exr));
+  EXPECT_NE(r.err.find("render: a first coarse image in " + png.string()), std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find('\r'), std::string::npos) << "no carriage returns off a terminal";
+  // The progress lines: "render: 40%, 3 s left", rising.
+  const std::regex line(R"(render: (\d+)%, [^\n]* left\n)");
+  int last = -1, count = 0;
+  for (auto it = std::sregex_iterator(r.err.begin(), r.err.end(), line);
+       it != std::sregex_iterator(); ++it) {
+    const int share = std::stoi((*it)[1]);
+    EXPECT_GE(share, last);
+    last = share;
+    ++count;
+  }
+  EXPECT_GE(count, 1) << r.err;
+  const auto doc = nlohmann::json::parse(std::ifstream(stats));
+  const auto& budget = doc.at("budget");
+  EXPECT_EQ(budget.at("budget_s").get<double>(), 8);
+  EXPECT_EQ(budget.at("requested"), "K 16, W_s 128, W_l 512, N 50, T 4");
+  EXPECT_FALSE(budget.at("requested_reached").get<bool>());  // minutes on a CPU, not 8 s
+  EXPECT_GT(budget.at("requested_predicted_s").get<double>(), 8);
+  ASSERT_GE(budget.at("levels_run").size(), 2u);
+  EXPECT_EQ(budget.at("levels_run").at(0), 0);
+  EXPECT_EQ(budget.at("level"), budget.at("levels_run").back());
+  EXPECT_NE(r.out.find("within --budget 8 s; the requested K 16"), std::string::npos) << r.out;
+  // The wall clock: the coarse image and the levels within the budget and a little (a level runs
+  // to its end once begun; 2 s for start-up and writing).
+  double total = 0;
+  for (const auto& s : budget.at("level_seconds")) total += s.get<double>();
+  EXPECT_LT(total, 8 + 2);
+  // The PNG and the EXR are one image: compared as displayed (the EXR at the auto exposure the
+  // PNG was written with), they differ by the PNG's 8-bit rounding alone.
+  EXPECT_LT(relative_rmse(png, exr), 0.01);
+  const fs::path again = dir / "again.png";
+  const auto t =
+      run_lucent("tonemap \"" + exr.string() + "\" -o \"" + again.string() + "\"", "tonemap");
+  ASSERT_EQ(t.exit_code, 0) << t.err;
+  EXPECT_EQ(relative_rmse(again, png), 0);  // tonemap after the render = the render's PNG
+  fs::remove_all(dir);
+}
+
+// Without a budget the refinement reaches the requested settings, and its image is the one the
+// explicit settings give (the same renderer, the same frames).
+TEST(RenderBudget, NoBudgetRefinesToTheExplicitSettingsImage) {
+  const auto dir = scratch_dir("render-budget-none");
+  const fs::path refined = dir / "refined.exr", explicit_ = dir / "explicit.exr";
+  const std::string fixed =
+      "--size 32x32 --maps-frames 3 --maps-radiance-map 64 "
+      "--maps-light-map 64 --maps-samples 8 --maps-disc-points 200 ";
+  const auto a = run_lucent(kScene + fixed + "--budget none --json -o \"" + refined.string() + "\"",
+                            "refined");
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  const auto doc = nlohmann::json::parse(a.out);
+  EXPECT_TRUE(doc.at("budget").at("requested_reached").get<bool>());
+  EXPECT_GE(doc.at("budget").at("levels_run").size(), 2u);  // a coarse level came first
+  const auto b = run_lucent(
+      kScene + fixed + "--maps-directions 16 -o \"" + explicit_.string() + "\"", "explicit");
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  EXPECT_LT(relative_rmse(refined, explicit_), 1e-6);
+  fs::remove_all(dir);
+}
+
+TEST(RenderBudget, RefusesABadBudgetAndTwoImagesOfOneKind) {
+  const auto dir = scratch_dir("render-budget-bad");
+  for (const std::string& bad : {"0", "-1", "nan", "soon"}) {
+    const auto r = run_lucent(
+        kScene + "--budget " + bad + " -o \"" + (dir / "x.png").string() + "\"", "bad-budget");
+    EXPECT_NE(r.exit_code, 0) << bad;
+    EXPECT_NE(r.err.find("--budget: expected seconds per image (> 0) or none, got '" + bad + "'"),
+              std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(dir / "x.png"));
+  }
+  const auto twice = run_lucent(
+      kScene + "-o \"" + (dir / "a.png").string() + "\" -o \"" + (dir / "b.png").string() + "\"",
+      "two-png");
+  EXPECT_NE(twice.exit_code, 0);
+  EXPECT_NE(twice.err.find("at most one .png and one .exr"), std::string::npos) << twice.err;
+  EXPECT_TRUE(fs::is_empty(dir));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace lucent::testing

@@ -1,0 +1,238 @@
+// The frame budget (render/core/frame_budget.cpp): the maps' quality ladder, the cost model, the
+// image budget's levels and the viewer's frame level, driven by a fake machine on a fake clock
+// (each pass costs a fixed part plus a part that grows with its work, as measured on llvmpipe).
+#include "lucent/render/frame_budget.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace lucent::render {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// A machine: the radiance map costs per layer a fixed part plus a part per texel-gather, the final
+// pass a fixed part plus per pixel-layer, each level's set-up and first frame (the compile) more.
+struct FakeMachine {
+  double layer_fixed_ms = 5, ms_per_million_gathers = 35;  // llvmpipe-like: ~28 M gathers/s
+  double light_ms_per_light = 4;
+  double final_fixed_ms = 80, final_ms_per_million_pixel_layers = 12;
+  double setup_ms = 300, compile_ms = 500;
+
+  double radiance_ms(const RenderSettings& s) const {
+    const double gathers = double(s.radiance_map_size) * s.radiance_map_size * s.samples;
+    return s.directions * (layer_fixed_ms + ms_per_million_gathers * gathers / 1e6);
+  }
+  double final_ms(const RenderSettings& s, int pixels) const {
+    return final_fixed_ms + final_ms_per_million_pixel_layers * double(pixels) * s.directions / 1e6;
+  }
+  double frame_ms(const RenderSettings& s, int pixels, int lights) const {
+    return radiance_ms(s) + lights * light_ms_per_light + final_ms(s, pixels);
+  }
+};
+
+class FakeRunner final : public BudgetLevelRunner {
+ public:
+  FakeRunner(const FakeMachine& machine, double& clock_s, int pixels, int lights)
+      : machine_(machine), clock_s_(clock_s), pixels_(pixels), lights_(lights) {}
+  void start(const RenderSettings& settings) override {
+    settings_ = settings;
+    frame_ = 0;
+    clock_s_ += machine_.setup_ms / 1000;
+  }
+  bool frame(MeasuredFrame& m) override {
+    if (frame_ >= settings_.frames) return false;
+    ++frame_;
+    m.radiance_ms = machine_.radiance_ms(settings_) + (frame_ == 1 ? machine_.compile_ms : 0);
+    m.light_ms = lights_ * machine_.light_ms_per_light;
+    m.final_ms = machine_.final_ms(settings_, pixels_);
+    clock_s_ += (m.radiance_ms + m.light_ms + m.final_ms) / 1000;
+    return true;
+  }
+  void level_done(int level, bool refined_next) override {
+    done.push_back({level, refined_next, clock_s_});
+  }
+  struct Done {
+    int level;
+    bool refined_next;
+    double at_s;
+  };
+  std::vector<Done> done;
+
+ private:
+  const FakeMachine& machine_;
+  double& clock_s_;
+  int pixels_, lights_;
+  RenderSettings settings_;
+  int frame_ = 0;
+};
+
+double level_seconds(const FakeMachine& m, const RenderSettings& s, int pixels, int lights) {
+  return (m.setup_ms + m.compile_ms + s.frames * m.frame_ms(s, pixels, lights)) / 1000;
+}
+
+TEST(QualityLadder, EndsAtTheRequestAndGrowsInWork) {
+  const RenderSettings requested;  // the seed's: K 16, W_s 512, W_l 512, N 50, T 100
+  const std::vector<RenderSettings> ladder = maps_quality_ladder(requested, {});
+  ASSERT_GE(ladder.size(), 4u);
+  EXPECT_EQ(quality_text(ladder.back()), quality_text(requested));
+  for (std::size_t i = 1; i < ladder.size(); ++i) {
+    const RenderSettings &a = ladder[i - 1], &b = ladder[i];
+    EXPECT_LE(a.directions, b.directions);
+    EXPECT_LE(a.radiance_map_size, b.radiance_map_size);
+    EXPECT_LE(a.light_map_size, b.light_map_size);
+    EXPECT_LE(a.samples, b.samples);
+    EXPECT_LE(a.frames, b.frames);
+    EXPECT_NO_THROW(a.validate());
+  }
+  // The first image is a thousandth of a requested frame's work or less, over two frames.
+  const auto work = [](const RenderSettings& s) {
+    return double(s.directions) * s.radiance_map_size * s.radiance_map_size * s.samples;
+  };
+  EXPECT_LE(work(ladder.front()), work(requested) / 1000);
+  EXPECT_EQ(ladder.front().frames, 2);
+}
+
+TEST(QualityLadder, ExplicitKnobsAreKeptAtEveryLevel) {
+  RenderSettings requested;
+  requested.directions = 6;
+  requested.frames = 3;
+  FixedKnobs fixed;
+  fixed.directions = fixed.frames = true;
+  for (const RenderSettings& s : maps_quality_ladder(requested, fixed)) {
+    EXPECT_EQ(s.directions, 6);
+    EXPECT_EQ(s.frames, 3);
+  }
+  fixed.samples = fixed.radiance_map = fixed.light_map = true;
+  EXPECT_EQ(maps_quality_ladder(requested, fixed).size(), 1u);  // nothing left to scale
+}
+
+TEST(QualityLadder, ASmallRequestHasFewLevels) {
+  RenderSettings requested;
+  requested.directions = 1;
+  requested.samples = 1;
+  requested.radiance_map_size = 32;
+  requested.light_map_size = 64;
+  requested.frames = 2;
+  EXPECT_EQ(maps_quality_ladder(requested, {}).size(), 1u);  // every level would be the request
+}
+
+TEST(AffineCost, OneAmountOfWorkPredictsThroughTheOriginAndTwoSeparateTheFixedPart) {
+  AffineCost cost;
+  cost.record(100, 50);
+  EXPECT_DOUBLE_EQ(cost.predict(400), 200);  // over-predicts a machine with a fixed part
+  cost.record(400, 80);                      // ms = 40 + 0.1 x
+  EXPECT_NEAR(cost.predict(1000), 140, 1e-9);
+  EXPECT_NEAR(cost.predict(100), 50, 1e-9);
+}
+
+TEST(ImageBudget, NoBudgetRefinesToTheRequestedSettings) {
+  const FakeMachine machine;
+  double clock = 0;
+  FakeRunner runner(machine, clock, 64 * 64, 1);
+  const std::vector<RenderSettings> ladder = maps_quality_ladder(RenderSettings{}, {});
+  const ImageBudgetRun run = run_image_budget(
+      ladder, kInf, 64 * 64, 1, [&] { return clock; }, runner);
+  EXPECT_EQ(run.level, int(ladder.size()) - 1);
+  ASSERT_FALSE(runner.done.empty());
+  EXPECT_EQ(runner.done.front().level, 0);  // the coarse image first ...
+  EXPECT_TRUE(runner.done.front().refined_next);
+  EXPECT_FALSE(runner.done.back().refined_next);  // ... the requested one last
+}
+
+TEST(ImageBudget, TheFirstImageComesEarlyAndTheRefinedOneFitsTheBudget) {
+  const FakeMachine machine;
+  const int pixels = 640 * 480, lights = 3;
+  const std::vector<RenderSettings> ladder = maps_quality_ladder(RenderSettings{}, {});
+  for (const double budget_s : {5.0, 20.0, 60.0, 300.0}) {
+    SCOPED_TRACE(budget_s);
+    double clock = 0;
+    FakeRunner runner(machine, clock, pixels, lights);
+    std::vector<double> shares;
+    const ImageBudgetRun run = run_image_budget(
+        ladder, budget_s, pixels, lights, [&] { return clock; }, runner,
+        [&](double share, double) { shares.push_back(share); });
+    // The first image within 2 s on this machine (the target on llvmpipe).
+    EXPECT_LT(runner.done.front().at_s, 2.0);
+    // Within the budget (the model over-predicts before it has two levels' frames, never under).
+    EXPECT_LE(clock, budget_s);
+    // Not far below it: the best level that fits alone after the coarse one would have been
+    // within the budget, and the one chosen is that one or one below it.
+    int best = 0;
+    for (int l = 1; l < int(ladder.size()); ++l)
+      if (runner.done.front().at_s +
+              level_seconds(machine, ladder[std::size_t(l)], pixels, lights) <=
+          budget_s)
+        best = l;
+    EXPECT_GE(run.level, best - 1);
+    // Progress only forward within a level's plan, and between 0 and 1.
+    for (double s : shares) {
+      EXPECT_GE(s, 0.0);
+      EXPECT_LE(s, 1.0);
+    }
+  }
+}
+
+TEST(ImageBudget, TheModelLearnsTheMachineFromTheLevelsItRan) {
+  const FakeMachine machine;
+  const int pixels = 640 * 480, lights = 1;
+  const std::vector<RenderSettings> ladder = maps_quality_ladder(RenderSettings{}, {});
+  double clock = 0;
+  FakeRunner runner(machine, clock, pixels, lights);
+  const ImageBudgetRun run = run_image_budget(
+      ladder, 60, pixels, lights, [&] { return clock; }, runner);
+  ASSERT_GE(run.levels_run.size(), 2u);
+  // Two levels measured: the requested frame predicted within a factor 2 of the machine's (it is
+  // extrapolated 4-40x beyond the work measured).
+  const double truth = machine.frame_ms(ladder.back(), pixels, lights);
+  EXPECT_GT(run.requested_frame_ms, 0.5 * truth);
+  EXPECT_LT(run.requested_frame_ms, 2.0 * truth);
+}
+
+TEST(FrameSplit, EachCallFitsTheBudgetAndAWholeFrameIsOneCall) {
+  // A frame that fits is not split.
+  FrameSplit split = plan_split(2, 16, 10, 50);
+  EXPECT_EQ(split.bands, 1);
+  EXPECT_EQ(split.units_per_call, 0);
+  for (const double layer_ms : {5.0, 20.0, 90.0, 470.0, 3000.0}) {
+    for (const double budget_ms : {30.0, 50.0, 100.0}) {
+      SCOPED_TRACE(testing::Message() << layer_ms << " ms a layer, " << budget_ms << " ms budget");
+      split = plan_split(layer_ms, 16, 20, budget_ms);
+      ASSERT_GE(split.bands, 1);
+      ASSERT_LE(split.bands, 64);
+      EXPECT_EQ(split.bands & (split.bands - 1), 0);  // a power of two
+      const double unit = layer_ms / split.bands;
+      const int units = split.units_per_call == 0 ? 16 * split.bands : split.units_per_call;
+      // Within the budget after the final pass (or half the budget when the final pass takes
+      // more: the viewer lowers the resolution then), one unit where one is over it (a layer of
+      // 3 s in 64 bands is 47 ms).
+      const double room = std::max(budget_ms - 20, 0.5 * budget_ms);
+      if (units > 1) {
+        EXPECT_LE(units * unit, room + 1e-9);
+      }
+      if (split.bands < 64) {
+        EXPECT_LE(unit, 0.5 * budget_ms);
+      }
+      // Not wastefully small: one more unit would not have fitted.
+      if (split.units_per_call > 0 && units < 16 * split.bands && unit <= room) {
+        EXPECT_GT((units + 1) * unit, room);
+      }
+    }
+  }
+}
+
+TEST(FrameSplit, ALargerLevelIsPredictedInProportionToItsWork) {
+  RenderSettings small, large;
+  small.radiance_map_size = 64;
+  small.samples = 9;
+  large.radiance_map_size = 256;
+  large.samples = 25;
+  EXPECT_NEAR(predict_layer_ms(10, small, large), 10 * 16 * 25 / 9.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace lucent::render
