@@ -100,6 +100,12 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
                   "distance from the centre in bounding-sphere radii; field of view 35 degrees")
       ->capture_default_str();
   cmd->add_option("--size", args->size, size_help)->capture_default_str();
+  cmd->add_option("--crease-angle", args->crease_angle_deg,
+                  "a mesh file without normals: edges where faces meet at more than this angle "
+                  "are hard (flat shading on each side: cubes, tiles, slabs); 180 smooths "
+                  "everything. A file's own normals (OBJ vn, PLY nx ny nz) are always used")
+      ->check(number_in(0, 180, "degrees"))
+      ->capture_default_str();
   cmd->add_option("--object-size-mm", args->object_size_mm, "bounding-box diagonal of the mesh, mm")
       ->check(number_in(0, 1e6, "mm", true))
       ->capture_default_str();
@@ -313,7 +319,7 @@ SceneSetup build_scene(SceneArguments& args) {
                          ? materials::parse_diffusion_model(args.model, "--model", true)
                          : materials::preferred_model(scene.material);
   if (technique.models.size() == 1) o.settings.model = technique.models.front();
-  scene.mesh = load_mesh(args.mesh, args.object_size_mm);
+  scene.mesh = load_mesh(args.mesh, args.object_size_mm, args.crease_angle_deg);
   scene.lights = lights;
   if (env) {
     const EnvironmentMap map = load_environment(env->path);

@@ -30,6 +30,7 @@ struct SceneArguments {
   std::string view = "30,20,3.4";  // 3.4 radii: the bounding sphere fits the 35-degree view
   std::string size;
   double object_size_mm = 100;
+  double crease_angle_deg = render::kDefaultCreaseAngleDeg;  ///< --crease-angle
   std::string exposure = "auto";  ///< a number or auto (tone_map.h auto_exposure)
   bool auto_exposure = true;      ///< set by build_scene from `exposure`
   float roughness = 0.1f;

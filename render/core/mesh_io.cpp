@@ -2,6 +2,7 @@
 #include "lucent/render/mesh_io.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <charconv>
 #include <cmath>
@@ -9,6 +10,7 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <optional>
 #include <vector>
 
@@ -396,11 +398,52 @@ Mesh parse_ply(std::string_view bytes, const std::string& source) {
   return mesh;
 }
 
+namespace {
+
+// One `v`/`vn` statement's three numbers.
+Vec3f obj_triple(const std::vector<std::string_view>& w, const std::string& source,
+                 const std::string& where, const char* statement) {
+  if (w.size() < 4) throw Error(source + ": " + where + ": expected '" + statement + " x y z'");
+  float c[3];
+  for (int i = 0; i < 3; ++i) {
+    const auto [ptr, ec] =
+        std::from_chars(w[1 + i].data(), w[1 + i].data() + w[1 + i].size(), c[i]);
+    if (ec != std::errc() || ptr != w[1 + i].data() + w[1 + i].size())
+      throw Error(source + ": " + where + ": expected a number, got '" +
+                  std::string(w[1 + i].substr(0, 32)) + "'");
+  }
+  const Vec3f p(c[0], c[1], c[2]);
+  check_finite(p, source, where);
+  return p;
+}
+
+// An index of a face corner (1-based, or negative from the latest), checked against `count`.
+unsigned obj_index(std::string_view ref, std::size_t count, const std::string& source,
+                   const std::string& where, std::string_view corner, const char* what,
+                   const char* plural) {
+  long long k = 0;
+  const auto [ptr, ec] = std::from_chars(ref.data(), ref.data() + ref.size(), k);
+  if (ec != std::errc() || ptr != ref.data() + ref.size() || k == 0)
+    throw Error(source + ": " + where + ": expected a " + what +
+                " index (1-based, or negative), got '" + std::string(corner.substr(0, 32)) + "'");
+  const long long n = static_cast<long long>(count);
+  const long long index = k > 0 ? k - 1 : n + k;
+  if (index < 0 || index >= n)
+    throw Error(source + ": " + where + ": " + what + " index " + std::to_string(k) +
+                " is out of range (" + std::to_string(n) + " " + plural + " so far)");
+  return static_cast<unsigned>(index);
+}
+
+}  // namespace
+
 Mesh parse_obj(std::string_view text, const std::string& source) {
-  Mesh mesh;
+  std::vector<Vec3f> positions, normals;
+  // Each face corner: its position and its normal (~0u: none given).
+  std::vector<std::array<std::pair<unsigned, unsigned>, 3>> corners;
   std::size_t pos = 0;
   long line_number = 0;
-  std::vector<unsigned> polygon;
+  std::vector<std::pair<unsigned, unsigned>> polygon;
+  bool any_normal = false;
   while (pos < text.size()) {
     const std::size_t nl = text.find('\n', pos);
     const std::size_t end = nl == std::string_view::npos ? text.size() : nl;
@@ -411,37 +454,56 @@ Mesh parse_obj(std::string_view text, const std::string& source) {
     if (w.empty() || w[0].front() == '#') continue;
     const std::string where = "line " + std::to_string(line_number);
     if (w[0] == "v") {
-      if (w.size() < 4) throw Error(source + ": " + where + ": expected 'v x y z'");
-      float c[3];
-      for (int i = 0; i < 3; ++i) {
-        const auto [ptr, ec] = std::from_chars(w[1 + i].data(), w[1 + i].data() + w[1 + i].size(), c[i]);
-        if (ec != std::errc() || ptr != w[1 + i].data() + w[1 + i].size())
-          throw Error(source + ": " + where + ": expected a number, got '" +
-                      std::string(w[1 + i].substr(0, 32)) + "'");
-      }
-      const Vec3f p(c[0], c[1], c[2]);
-      check_finite(p, source, where);
-      mesh.positions.push_back(p);
+      positions.push_back(obj_triple(w, source, where, "v"));
+    } else if (w[0] == "vn") {
+      normals.push_back(obj_triple(w, source, where, "vn"));
     } else if (w[0] == "f") {
       if (w.size() < 4) throw Error(source + ": " + where + ": a face needs at least 3 vertices");
       polygon.clear();
       for (std::size_t i = 1; i < w.size(); ++i) {
-        const std::string_view ref = w[i].substr(0, w[i].find('/'));
-        long long k = 0;
-        const auto [ptr, ec] = std::from_chars(ref.data(), ref.data() + ref.size(), k);
-        if (ec != std::errc() || ptr != ref.data() + ref.size() || k == 0)
-          throw Error(source + ": " + where + ": expected a vertex index (1-based, or negative), got '" +
-                      std::string(w[i].substr(0, 32)) + "'");
-        const long long n = static_cast<long long>(mesh.positions.size());
-        const long long index = k > 0 ? k - 1 : n + k;
-        if (index < 0 || index >= n)
-          throw Error(source + ": " + where + ": vertex index " + std::to_string(k) +
-                      " is out of range (" + std::to_string(n) + " vertices so far)");
-        polygon.push_back(static_cast<unsigned>(index));
+        // v, v/t, v/t/n or v//n.
+        const std::string_view corner = w[i];
+        const std::size_t slash = corner.find('/');
+        const unsigned v = obj_index(corner.substr(0, slash), positions.size(), source, where,
+                                     corner, "vertex", "vertices");
+        unsigned n = ~0u;
+        if (slash != std::string_view::npos) {
+          const std::size_t second = corner.find('/', slash + 1);
+          if (second != std::string_view::npos && second + 1 < corner.size()) {
+            n = obj_index(corner.substr(second + 1), normals.size(), source, where, corner,
+                          "normal", "normals");
+            any_normal = true;
+          }
+        }
+        polygon.emplace_back(v, n);
       }
       for (std::size_t j = 2; j < polygon.size(); ++j)
-        mesh.triangles.push_back({polygon[0], polygon[j - 1], polygon[j]});
+        corners.push_back({polygon[0], polygon[j - 1], polygon[j]});
     }
+  }
+  Mesh mesh;
+  if (!any_normal) {
+    mesh.positions = std::move(positions);
+    for (const auto& t : corners) mesh.triangles.push_back({t[0].first, t[1].first, t[2].first});
+    return mesh;
+  }
+  // With normals a vertex is a position and a normal: a corner of a hard edge (a cube's) is as
+  // many vertices as normals meet there. Corners without one get a zero normal, which load_mesh
+  // replaces by the area-weighted one.
+  std::map<std::pair<unsigned, unsigned>, unsigned> vertex_of;
+  for (const auto& t : corners) {
+    std::array<unsigned, 3> triangle{};
+    for (int k = 0; k < 3; ++k) {
+      const auto [it, inserted] =
+          vertex_of.try_emplace(t[std::size_t(k)], unsigned(mesh.positions.size()));
+      if (inserted) {
+        mesh.positions.push_back(positions[t[std::size_t(k)].first]);
+        mesh.normals.push_back(t[std::size_t(k)].second == ~0u ? Vec3f::Zero()
+                                                               : normals[t[std::size_t(k)].second]);
+      }
+      triangle[std::size_t(k)] = it->second;
+    }
+    mesh.triangles.push_back(triangle);
   }
   return mesh;
 }

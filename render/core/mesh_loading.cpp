@@ -326,8 +326,59 @@ std::vector<Vec3f> area_weighted_normals(const Mesh& mesh) {
   return normals;
 }
 
+std::size_t crease_normals(Mesh& mesh, double crease_angle_deg) {
+  // Corners that share a position are one vertex of the surface (a file's seams), welded first.
+  const std::vector<unsigned> id = welded_ids(mesh);
+  std::vector<Eigen::Vector3d> face(mesh.triangles.size());
+  std::vector<std::vector<unsigned>> around(mesh.positions.size());
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto& tri = mesh.triangles[t];
+    const Eigen::Vector3d a = mesh.positions[tri[0]].cast<double>(),
+                          b = mesh.positions[tri[1]].cast<double>(),
+                          c = mesh.positions[tri[2]].cast<double>();
+    face[t] = (b - a).cross(c - a);  // area-weighted
+    for (unsigned v : tri) around[id[v]].push_back(unsigned(t));
+  }
+  const double cos_crease = std::cos(crease_angle_deg * 3.14159265358979323846 / 180);
+  // Each corner: the area-weighted normal of the faces around its vertex within the crease angle
+  // of its own face. A vertex keeps its index for its first normal and is copied for each other.
+  std::vector<std::vector<std::pair<Vec3f, unsigned>>> made(mesh.positions.size());
+  const std::size_t before = mesh.positions.size();
+  std::vector<Vec3f> normals(before, Vec3f::Zero());
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const double own_length = face[t].norm();
+    for (unsigned& v : mesh.triangles[t]) {
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      for (unsigned f : around[id[v]]) {
+        const double length = face[f].norm();
+        if (own_length > 0 && length > 0 &&
+            face[t].dot(face[f]) >= cos_crease * own_length * length)
+          sum += face[f];
+      }
+      const Vec3f n = sum.norm() > 0 ? Vec3f(sum.normalized().cast<float>()) : Vec3f(0, 0, 1);
+      auto& copies = made[v];
+      const auto same = std::find_if(copies.begin(), copies.end(), [&](const auto& c) {
+        return (c.first - n).squaredNorm() < 1e-10f;
+      });
+      if (same != copies.end()) {
+        v = same->second;
+      } else if (copies.empty()) {
+        copies.emplace_back(n, v);
+        normals[v] = n;
+      } else {
+        const unsigned copy = unsigned(mesh.positions.size());
+        mesh.positions.push_back(mesh.positions[v]);
+        normals.push_back(n);
+        copies.emplace_back(n, copy);
+        v = copy;
+      }
+    }
+  }
+  mesh.normals = std::move(normals);
+  return mesh.positions.size() - before;
+}
 
-Mesh load_mesh(const std::string& name_or_path, double object_size_mm) {
+Mesh load_mesh(const std::string& name_or_path, double object_size_mm, double crease_angle_deg) {
   check_object_size(object_size_mm);
   Mesh mesh;
   bool exact_normals = false;
@@ -372,6 +423,7 @@ Mesh load_mesh(const std::string& name_or_path, double object_size_mm) {
       throw Error(path.string() + ": unsupported mesh format (expected a .ply or .obj file)");
     }
     mesh = load_mesh_file(path);
+    return finish_mesh(std::move(mesh), name_or_path, object_size_mm, false, crease_angle_deg);
   }
   return finish_mesh(std::move(mesh), name_or_path, object_size_mm, exact_normals);
 }
@@ -386,7 +438,12 @@ void check_object_size(double object_size_mm) {
 }
 
 Mesh finish_mesh(Mesh mesh, const std::string& name_or_path, double object_size_mm,
-                 bool exact_normals) {
+                 bool exact_normals, double crease_angle_deg) {
+  if (!(crease_angle_deg >= 0 && crease_angle_deg <= 180)) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%g", crease_angle_deg);
+    throw Error(std::string("--crease-angle: expected degrees in [0, 180], got ") + text);
+  }
   check_object_size(object_size_mm);
   mesh.name = name_or_path;
 
@@ -412,6 +469,11 @@ Mesh finish_mesh(Mesh mesh, const std::string& name_or_path, double object_size_
     // File normals are kept (normalised) where usable, turned outward as a whole if the file has
     // them pointing in; a mesh without them, or a vertex whose normal is zero or not finite, gets
     // the area-weighted average of its faces.
+    if (mesh.normals.size() != mesh.positions.size() && crease_angle_deg < 180) {
+      // No normals in the file: hard edges where faces meet at more than the crease angle.
+      mesh.normals.clear();
+      crease_normals(mesh, crease_angle_deg);
+    }
     const std::vector<Vec3f> computed = area_weighted_normals(mesh);
     if (mesh.normals.size() != mesh.positions.size()) {
       mesh.normals = computed;

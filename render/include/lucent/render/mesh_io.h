@@ -18,9 +18,10 @@ namespace lucent::render {
 /// properties are skipped. Positions in the file's units (load_mesh scales them).
 Mesh parse_ply(std::string_view bytes, const std::string& source);
 
-/// Wavefront OBJ: `v x y z [w]` and `f a b c ...` (a, a/t, a/t/n or a//n; negative indices count
-/// back from the latest vertex); polygons as triangle fans. Normals (`vn`) are not read: the
-/// renderer computes area-weighted ones. Other statements are ignored.
+/// Wavefront OBJ: `v x y z [w]`, `vn x y z` and `f a b c ...` (a, a/t, a/t/n or a//n; negative
+/// indices count back from the latest); polygons as triangle fans. Where faces give normals, a
+/// vertex is a position with a normal (a cube's corner is three vertices, one per face), and a
+/// corner without one gets a zero normal (load_mesh computes it). Other statements are ignored.
 Mesh parse_obj(std::string_view text, const std::string& source);
 
 /// Largest bounding-box diagonal a scene may have, mm (1 km; beyond it float positions lose the
@@ -32,8 +33,16 @@ void check_object_size(double object_size_mm);
 
 /// What load_mesh does after reading: drops degenerate triangles, refuses a mesh without any,
 /// centres and scales it to `object_size_mm`, orients it outward and gives it unit normals (the
-/// file's where usable, else area-weighted), warning about non-manifold edges.
+/// file's where usable; a mesh without them, crease_normals at `crease_angle_deg` below 180, else
+/// area-weighted), warning about non-manifold edges.
 Mesh finish_mesh(Mesh mesh, const std::string& name_or_path, double object_size_mm,
-                 bool exact_normals = false);
+                 bool exact_normals = false, double crease_angle_deg = 180);
+
+/// Normals with hard edges: each triangle corner gets the area-weighted normal of the triangles
+/// around its vertex (corners at one position are one vertex) whose normals are within
+/// `crease_angle_deg` of its own triangle's; a vertex with corners of different normals is copied,
+/// one per normal (a cube's corner becomes three). Returns the vertices added. 180: smooth
+/// everywhere; 0: flat.
+std::size_t crease_normals(Mesh& mesh, double crease_angle_deg);
 
 }  // namespace lucent::render

@@ -111,10 +111,14 @@ Light parse_light(const std::string& text);
 
 /// Built-in meshes and files: "sphere" (an icosphere of 5120 triangles; "sphere:L" has 20 x 4^L,
 /// L 0..7), "bunny", "dragon:1".."dragon:4" (1 finest; from the npm data
-/// cache, $LUCENT_DATA_CACHE or ~/.cache/lucent), or a path to a PLY or OBJ file (Assimp). The mesh
-/// is centred and scaled so that its bounding-box diagonal is `object_size_mm`. Empty meshes throw;
-/// non-manifold ones load with a warning on stderr.
-Mesh load_mesh(const std::string& name_or_path, double object_size_mm = 100.0);
+/// cache, $LUCENT_DATA_CACHE or ~/.cache/lucent), or a path to a PLY or OBJ file. The mesh is
+/// centred and scaled so that its bounding-box diagonal is `object_size_mm`. A file's normals (OBJ
+/// `vn`, PLY nx ny nz) are used; a file without them gets hard edges where faces meet at more
+/// than `crease_angle_deg` (kDefaultCreaseAngleDeg; 180: smooth everywhere), the built-in scans
+/// smooth normals. Empty meshes throw; non-manifold ones load with a warning on stderr.
+inline constexpr double kDefaultCreaseAngleDeg = 60;
+Mesh load_mesh(const std::string& name_or_path, double object_size_mm = 100.0,
+               double crease_angle_deg = kDefaultCreaseAngleDeg);
 
 /// Area-weighted vertex normals: the normalised sum of the (unnormalised) face cross products around
 /// each vertex; +z where the sum vanishes. load_mesh uses them where a file has no normals, and a
