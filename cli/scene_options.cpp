@@ -60,7 +60,7 @@ EnvironmentArgument parse_environment_argument(const std::string& text) {
       env.lights = tail.size() > 6 ? 1000000 : std::stoi(tail);
     }
   }
-  if (env.path.empty()) throw Error("--env: expected FILE[:L], got '" + text + "'");
+  if (env.path.empty()) throw Error("--env: expected FILE[:L] or NAME[:L], got '" + text + "'");
   if (env.lights < 1 || env.lights > 4096) {
     throw Error("--env: the number of lights L must be 1..4096, got '" + text + "'");
   }
@@ -84,8 +84,10 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
                   "light: centre and half-edge vectors in mm, R,G,B radiance, emitting toward U x "
                   "V); repeatable");
   cmd->add_option("--env", args->env,
-                  "FILE[:L]: lat-long environment map (.exr or .hdr), shown as background and lit "
-                  "by L importance-sampled directional lights (default L = 16)");
+                  "FILE[:L] or NAME[:L]: lat-long environment map (.exr or .hdr), or one the data "
+                  "package brings by name (studio, sunset, forest, city, ...: Poly Haven's CC0 "
+                  "HDRIs; an unknown name lists them), shown as background and lit by L "
+                  "importance-sampled directional lights (default L = 16)");
   std::string technique_help;
   const auto& all = render::techniques();
   for (std::size_t i = 0; i < all.size(); ++i)
@@ -322,6 +324,7 @@ SceneSetup build_scene(SceneArguments& args) {
   scene.mesh = load_mesh(args.mesh, args.object_size_mm, args.crease_angle_deg);
   scene.lights = lights;
   if (env) {
+    env->path = resolve_environment(env->path).string();  // a bundled map's name: its file
     const EnvironmentMap map = load_environment(env->path);
     const auto env_lights = environment_lights(map, env->lights, o.reference.seed);
     if (env_lights.empty() && lights.empty()) {

@@ -6,9 +6,12 @@
 #include <cmath>
 #include <numbers>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "lucent/core/error.h"
 #include "lucent/imaging/image_io.h"
+#include "lucent/render/scene.h"
 
 namespace lucent::render {
 namespace {
@@ -64,6 +67,30 @@ std::string EnvironmentMap::to_string() const {
   s << "EnvironmentMap{" << source.string() << ", " << image.width << "x" << image.height
     << " lat-long}";
   return s.str();
+}
+
+std::vector<std::string> environment_names() {
+  std::vector<std::string> names;
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(data_cache_dir() / "hdri", error))
+    if (lower_extension(entry.path()) == ".exr") names.push_back(entry.path().stem().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+fs::path resolve_environment(const std::string& name_or_path) {
+  const fs::path given(name_or_path);
+  if (fs::exists(given) || given.has_extension() || given.has_parent_path()) return given;
+  const fs::path file = data_cache_dir() / "hdri" / (name_or_path + ".exr");
+  if (fs::is_regular_file(file)) return file;
+  const std::vector<std::string> names = environment_names();
+  std::string list;
+  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+  throw Error("--env: '" + name_or_path + "' is neither a file nor a bundled environment map (" +
+              (names.empty() ? "none in " + (data_cache_dir() / "hdri").string() +
+                                   ": run scripts/install-deps to fetch them"
+                             : list) +
+              ")");
 }
 
 EnvironmentMap load_environment(const fs::path& path) {

@@ -62,9 +62,8 @@ std::vector<RenderSettings> maps_quality_ladder(const RenderSettings& requested,
   return ladder;
 }
 
-// Fits ms = a + b x to (x, ms) pairs; with a single x (or a fit that comes out negative) the
-// conservative ms = b x through the origin with the largest measured ratio, which over-predicts a
-// larger x.
+// Fits ms = a + b x to (x, ms) pairs; with a single x (or a fit that comes out negative) a
+// conservative guess from the point with the largest ratio.
 void AffineCost::record(double x, double ms) {
   if (!(x > 0) || !(ms >= 0) || !std::isfinite(ms)) return;
   // One point per amount of work (the level it was measured at), its ms a running mean in which
@@ -102,7 +101,17 @@ double AffineCost::predict(double x) const {
     if (b >= 0 && a >= 0) return a + b * x;
     if (b > 0) return std::max(0.0, a + b * x);  // a < 0 within noise: still the measured slope
   }
-  return max_ratio * x;
+  // One amount of work (or a fit that came out negative): half of the largest measured time taken
+  // as fixed and half as growing with the work (on llvmpipe the fixed part of the coarse level's
+  // layer is 50-80%), which still over-predicts a larger x, the safe side of a budget, without
+  // ruling out every level above the first.
+  double at = 0, ms = 0;
+  for (const auto& [xi, yi] : samples_)
+    if (yi / xi >= max_ratio) {
+      at = xi;
+      ms = yi;
+    }
+  return x <= at ? ms * x / at : ms * (0.5 + 0.5 * x / at);
 }
 
 void FrameCostModel::record(const MeasuredFrame& f) {
@@ -140,56 +149,80 @@ ImageBudgetRun run_image_budget(const std::vector<RenderSettings>& ladder, doubl
                                 const std::function<void(double, double)>& progress) {
   if (ladder.empty()) throw std::logic_error("run_image_budget: no levels");
   const double t0 = now_s();
+  const auto elapsed = [&] { return now_s() - t0; };
+  const bool bounded = !std::isinf(budget_s);
   FrameCostModel cost;
   ImageBudgetRun run;
   double setup_s = 0;
   // The plan in predicted seconds from t0, for the progress: the coarse level's first guess is
   // a second per frame until a frame has been measured.
   double planned_end_s = 0;
-  int level = 0;
+  int level = 0, done = -1;
+  int ceiling = int(ladder.size());  // levels from here up are known not to fit
   for (;;) {
     const RenderSettings& s = ladder[std::size_t(level)];
     const double level_start = now_s();
     runner.start(s);
     setup_s = std::max(setup_s, now_s() - level_start);
     if (level == 0) planned_end_s = setup_s + s.frames;
-    bool first = true;
+    int frames = 0;
+    bool abandoned = false;
     MeasuredFrame m;
     while (runner.frame(m)) {
       // A level's first frame compiles its programs (drivers compile at the first draw;
       // llvmpipe's JIT takes ~0.5 s): it says nothing of the frames after it.
-      if (!std::exchange(first, false)) {
+      if (++frames > 1) {
         m.settings = s;
         m.pixels = pixels;
         m.lights = lights;
         cost.record(m);
-        if (level == 0)
-          planned_end_s = setup_s + s.frames * cost.frame_ms(s, pixels, lights) / 1000;
+        const double rest_s = (s.frames - frames) * cost.frame_ms(s, pixels, lights) / 1000;
+        planned_end_s = elapsed() + rest_s;
+        // Measured, a refinement that will not fit is given up (the last level's image stands):
+        // the prediction that chose it had seen smaller work only.
+        if (level > 0 && bounded && frames == 2 && elapsed() + rest_s > budget_s) {
+          abandoned = true;
+          break;
+        }
       }
       if (progress) {
-        const double done = now_s() - t0;
-        progress(std::clamp(done / std::max(planned_end_s, 1e-9), 0.0, 1.0),
-                 std::max(0.0, planned_end_s - done));
+        progress(std::clamp(elapsed() / std::max(planned_end_s, 1e-9), 0.0, 1.0),
+                 std::max(0.0, planned_end_s - elapsed()));
       }
       m = MeasuredFrame{};
     }
     run.level_seconds.push_back(now_s() - level_start);
     run.levels_run.push_back(level);
-    run.level = level;
-    int next = 0;
-    if (level + 1 < int(ladder.size())) {
-      const std::vector<RenderSettings> above(ladder.begin() + level, ladder.end());
-      const double left = std::isinf(budget_s) ? budget_s : budget_s - (now_s() - t0);
+    if (abandoned) {
+      ceiling = level;
+    } else {
+      done = level;
+    }
+    // The next level: the highest below the ceiling predicted to fit; when none is, the next one
+    // is tried if its prediction is within three times what is left (the model over-predicts
+    // before it has seen two amounts of work; a try that will not fit is given up after a frame).
+    int next = -1;
+    if (done + 1 < ceiling) {
+      const std::vector<RenderSettings> above(ladder.begin() + done, ladder.begin() + ceiling);
+      const double left = bounded ? budget_s - elapsed() : budget_s;
       const ImagePlan plan = plan_image(above, cost, pixels, lights, setup_s, left);
       if (plan.level > 0) {
-        next = level + plan.level;
-        planned_end_s = (now_s() - t0) + plan.predicted_s;
+        next = done + plan.level;
+        planned_end_s = elapsed() + plan.predicted_s;
+      } else {
+        const RenderSettings& n = ladder[std::size_t(done + 1)];
+        const double predicted = setup_s + n.frames * cost.frame_ms(n, pixels, lights) / 1000;
+        if (predicted <= 3 * left && setup_s + 2 * cost.frame_ms(n, pixels, lights) / 1000 < left) {
+          next = done + 1;
+          planned_end_s = elapsed() + predicted;
+        }
       }
     }
-    runner.level_done(level, next > 0);
-    if (next == 0) break;
+    if (!abandoned) runner.level_done(level, next >= 0);
+    if (next < 0) break;
     level = next;
   }
+  run.level = done;
   run.requested_frame_ms = cost.frame_ms(ladder.back(), pixels, lights);
   return run;
 }

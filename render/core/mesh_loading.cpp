@@ -44,14 +44,6 @@ std::string read_file(const fs::path& path, const std::string& what) {
   return s.str();
 }
 
-// $LUCENT_DATA_CACHE, else $XDG_CACHE_HOME/lucent, else ~/.cache/lucent (as scripts/install-deps).
-fs::path data_cache_dir() {
-  if (const char* dir = std::getenv("LUCENT_DATA_CACHE"); dir && *dir) return dir;
-  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return fs::path(xdg) / "lucent";
-  const char* home = std::getenv("HOME");
-  return fs::path(home && *home ? home : ".") / ".cache" / "lucent";
-}
-
 fs::path data_package_file(const std::string& mesh, const std::string& package,
                            const std::string& file) {
   const fs::path dir = data_cache_dir() / "node_modules" / package;
@@ -324,6 +316,14 @@ std::vector<Vec3f> area_weighted_normals(const Mesh& mesh) {
     if (sum[i].norm() > 0) normals[i] = sum[i].normalized().cast<float>();
   }
   return normals;
+}
+
+// $LUCENT_DATA_CACHE, else $XDG_CACHE_HOME/lucent, else ~/.cache/lucent (as scripts/install-deps).
+fs::path data_cache_dir() {
+  if (const char* dir = std::getenv("LUCENT_DATA_CACHE"); dir && *dir) return dir;
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return fs::path(xdg) / "lucent";
+  const char* home = std::getenv("HOME");
+  return fs::path(home && *home ? home : ".") / ".cache" / "lucent";
 }
 
 std::size_t crease_normals(Mesh& mesh, double crease_angle_deg) {

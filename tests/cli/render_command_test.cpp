@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -317,6 +318,43 @@ TEST(RenderCommand, JsonSummaryOnStdout) {
   EXPECT_GT(doc.at("exposure").get<double>(), 0);
   EXPECT_GT(doc.at("seconds").get<double>(), 0);
   EXPECT_TRUE(fs::exists(out));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace lucent::testing
+
+namespace lucent::testing {
+namespace {
+
+// --env NAME: a CC0 HDRI of the data package (scripts/install-deps), by name; an unknown name lists
+// the ones there are.
+TEST(RenderCommand, RendersABundledEnvironmentByName) {
+  const char* cache_env = std::getenv("LUCENT_DATA_CACHE");
+  const fs::path cache = cache_env && *cache_env ? fs::path(cache_env)
+                                                 : fs::path(std::getenv("HOME")) / ".cache/lucent";
+  if (!fs::exists(cache / "hdri/studio.exr"))
+    GTEST_SKIP() << "no environment maps in " << cache << " (run scripts/install-deps)";
+  const auto dir = scratch_dir("render-env-name");
+  const fs::path out = dir / "studio.exr";
+  const auto r = run_lucent(
+      kTiny + "--material marble --mesh sphere --env studio:4 -o \"" + out.string() + "\"",
+      "env-name");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const imaging::ImageRgb image = imaging::read_exr(out);
+  double corner = 0;  // the background is the studio, not black
+  for (int c = 0; c < 3; ++c) corner += image.at(0, 0, c);
+  EXPECT_GT(corner, 0);
+  const auto bad = run_lucent(kTiny + "--material marble --mesh sphere --env stuido -o \"" +
+                                  (dir / "x.exr").string() + "\"",
+                              "env-unknown");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_EQ(lines(bad.err), 1) << bad.err;
+  EXPECT_NE(bad.err.find("'stuido' is neither a file nor a bundled environment map"),
+            std::string::npos)
+      << bad.err;
+  EXPECT_NE(bad.err.find("studio"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir / "x.exr"));
   fs::remove_all(dir);
 }
 

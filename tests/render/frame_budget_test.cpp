@@ -124,7 +124,8 @@ TEST(QualityLadder, ASmallRequestHasFewLevels) {
 TEST(AffineCost, OneAmountOfWorkPredictsThroughTheOriginAndTwoSeparateTheFixedPart) {
   AffineCost cost;
   cost.record(100, 50);
-  EXPECT_DOUBLE_EQ(cost.predict(400), 200);  // over-predicts a machine with a fixed part
+  EXPECT_DOUBLE_EQ(cost.predict(400), 25 + 100);  // half fixed: over-predicts 40 + 0.1 x (80)
+  EXPECT_DOUBLE_EQ(cost.predict(50), 25);
   cost.record(400, 80);                      // ms = 40 + 0.1 x
   EXPECT_NEAR(cost.predict(1000), 140, 1e-9);
   EXPECT_NEAR(cost.predict(100), 50, 1e-9);
@@ -158,7 +159,8 @@ TEST(ImageBudget, TheFirstImageComesEarlyAndTheRefinedOneFitsTheBudget) {
         [&](double share, double) { shares.push_back(share); });
     // The first image within 2 s on this machine (the target on llvmpipe).
     EXPECT_LT(runner.done.front().at_s, 2.0);
-    // Within the budget (the model over-predicts before it has two levels' frames, never under).
+    // Within the budget (the model over-predicts before it has two levels' frames, on this
+    // machine, whose fixed part is over half the coarse level's).
     EXPECT_LE(clock, budget_s);
     // Not far below it: the best level that fits alone after the coarse one would have been
     // within the budget, and the one chosen is that one or one below it.
@@ -191,6 +193,39 @@ TEST(ImageBudget, TheModelLearnsTheMachineFromTheLevelsItRan) {
   const double truth = machine.frame_ms(ladder.back(), pixels, lights);
   EXPECT_GT(run.requested_frame_ms, 0.5 * truth);
   EXPECT_LT(run.requested_frame_ms, 2.0 * truth);
+}
+
+TEST(ImageBudget, TriesALevelTheFirstGuessRulesOutAndGivesUpOneThatWillNotFit) {
+  // A machine whose coarse level is almost all fixed cost (16 environment lights' light maps and
+  // a large final pass): from the coarse frames alone every refinement looks too dear.
+  FakeMachine machine;
+  machine.final_fixed_ms = 300;
+  machine.light_ms_per_light = 20;
+  const int pixels = 160 * 160, lights = 16;
+  const std::vector<RenderSettings> ladder = maps_quality_ladder(RenderSettings{}, {});
+  for (const double budget_s : {20.0, 40.0, 90.0}) {
+    SCOPED_TRACE(budget_s);
+    double clock = 0;
+    FakeRunner runner(machine, clock, pixels, lights);
+    const ImageBudgetRun run = run_image_budget(
+        ladder, budget_s, pixels, lights, [&] { return clock; }, runner);
+    ASSERT_FALSE(runner.done.empty());
+    EXPECT_EQ(run.level, runner.done.back().level);  // the image is the last level done
+    // Refined beyond the coarse level wherever a level fits after it.
+    const double after_coarse = budget_s - runner.done.front().at_s;
+    if (level_seconds(machine, ladder[1], pixels, lights) < after_coarse) {
+      EXPECT_GE(run.level, 1);
+    }
+    // Within the budget and one measured frame of a level given up (its set-up, the compile and
+    // two frames at most).
+    double slack = 0;
+    for (const RenderSettings& s : ladder)
+      slack = std::max(
+          slack,
+          (machine.setup_ms + machine.compile_ms + 2 * machine.frame_ms(s, pixels, lights)) / 1000);
+    EXPECT_LE(clock, budget_s + slack);
+    EXPECT_GE(run.levels_run.size(), runner.done.size());
+  }
 }
 
 TEST(FrameSplit, EachCallFitsTheBudgetAndAWholeFrameIsOneCall) {

@@ -18,7 +18,7 @@ class MapsLevelRunner final : public BudgetLevelRunner {
       : scene_(scene), options_(options), budget_(budget) {}
 
   void start(const RenderSettings& settings) override {
-    renderer_ = std::make_unique<RadianceMapRenderer>();  // the previous level's is released
+    renderer_ = std::make_unique<RadianceMapRenderer>();  // one given up is released
     renderer_->setup(scene_, settings, options_);
     settings_ = settings;
   }
@@ -36,17 +36,20 @@ class MapsLevelRunner final : public BudgetLevelRunner {
     return true;
   }
   void level_done(int level, bool refined_next) override {
-    if (refined_next && budget_.on_image) budget_.on_image(renderer_->read_image(), level);
+    done_ = std::move(renderer_);
+    done_settings_ = settings_;
+    if (refined_next && budget_.on_image) budget_.on_image(done_->read_image(), level);
   }
-  const RadianceMapRenderer& renderer() const { return *renderer_; }
-  const RenderSettings& settings() const { return settings_; }
+  /// The last level done (its renderer and settings).
+  const RadianceMapRenderer& renderer() const { return *done_; }
+  const RenderSettings& settings() const { return done_settings_; }
 
  private:
   const Scene& scene_;
   const RadianceMapOptions& options_;
   const BudgetedMapsOptions& budget_;
-  std::unique_ptr<RadianceMapRenderer> renderer_;
-  RenderSettings settings_;
+  std::unique_ptr<RadianceMapRenderer> renderer_, done_;
+  RenderSettings settings_, done_settings_;
 };
 
 }  // namespace

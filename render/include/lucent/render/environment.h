@@ -33,6 +33,14 @@ struct EnvironmentMap {
   std::string to_string() const;
 };
 
+/// The environment maps of the data package (scripts/install-deps: Poly Haven's CC0 HDRIs at
+/// 512 x 256, from npm's @pmndrs/assets): their names, sorted (studio, sunset, forest, ...).
+std::vector<std::string> environment_names();
+
+/// A file path as given, or a bundled map's name (no folder, no extension) as its file in the data
+/// cache; lucent::Error naming --env and listing the names otherwise.
+std::filesystem::path resolve_environment(const std::string& name_or_path);
+
 /// Reads `.exr` (OpenEXR, linear) or `.hdr` (Radiance RGBE) as a lat-long map. Anything else, a
 /// file that is not an image, or an image with negative or non-finite values throws lucent::Error
 /// naming the file.

@@ -45,8 +45,9 @@ struct MeasuredFrame {
 
 /// ms = a + b x fitted to measured (x, ms) pairs (one point per amount of work, 16 at most, each a
 /// running mean): least squares once two amounts of work 1.5x apart have been measured; before
-/// that, and where the fit comes out negative, b x through the origin with the largest measured
-/// ratio, which over-predicts a larger x (the safe side of a budget).
+/// that, and where the fit comes out negative, the point with the largest ratio with half its time
+/// taken as fixed, which over-predicts a larger x where the fixed part is larger (the safe side of
+/// a budget; on llvmpipe the coarse level's fixed part is 50-80%).
 class AffineCost {
  public:
   void record(double x, double ms);
@@ -90,25 +91,28 @@ ImagePlan plan_image(const std::vector<RenderSettings>& ladder, const FrameCostM
 class BudgetLevelRunner {
  public:
   virtual ~BudgetLevelRunner() = default;
-  /// Sets a level up (a renderer of `settings`).
+  /// Sets a level up (a renderer of `settings`); a level started and not done is given up.
   virtual void start(const RenderSettings& settings) = 0;
   /// One frame; false when the level had converged (no frame accumulated). Fills what it cost.
   virtual bool frame(MeasuredFrame& measured) = 0;
-  /// The level's frames are done; `refined_next`: a higher level follows (its image is a preview).
+  /// The level's frames are done: its image is the result unless a higher level is done later;
+  /// `refined_next`: a higher level is tried next (this image is a preview until then).
   virtual void level_done(int level, bool refined_next) = 0;
 };
 
 struct ImageBudgetRun {
-  int level = 0;                      ///< the last level run (the image's)
-  std::vector<int> levels_run;        ///< in order
+  int level = 0;                      ///< the last level done (the image's)
+  std::vector<int> levels_run;        ///< in order, those given up included
   std::vector<double> level_seconds;  ///< each one's set-up and frames, s
   double requested_frame_ms = 0;      ///< the cost model's prediction of a requested frame
 };
 
 /// The image budget: level 0, then while a higher level is predicted to fit what is left of
-/// `budget_s` (infinity: up to the last), the highest such. A level's first frame compiles its
-/// programs and is not measured. `now_s`: the clock (s); `progress(share, seconds left)` after
-/// every frame.
+/// `budget_s` (infinity: up to the last), the highest such; when none is predicted to, the next
+/// one is tried if predicted within three times what is left, and any level whose first measured
+/// frame says its frames will not fit is given up (the model learns from it). A level's first
+/// frame compiles its programs and is not measured. `now_s`: the clock (s); `progress(share,
+/// seconds left)` after every frame.
 ImageBudgetRun run_image_budget(const std::vector<RenderSettings>& ladder, double budget_s,
                                 int pixels, int lights, const std::function<double()>& now_s,
                                 BudgetLevelRunner& runner,

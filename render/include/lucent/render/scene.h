@@ -120,6 +120,10 @@ inline constexpr double kDefaultCreaseAngleDeg = 60;
 Mesh load_mesh(const std::string& name_or_path, double object_size_mm = 100.0,
                double crease_angle_deg = kDefaultCreaseAngleDeg);
 
+/// The data cache scripts/install-deps fills (meshes, environment maps): $LUCENT_DATA_CACHE, else
+/// $XDG_CACHE_HOME/lucent, else ~/.cache/lucent.
+std::filesystem::path data_cache_dir();
+
 /// Area-weighted vertex normals: the normalised sum of the (unnormalised) face cross products around
 /// each vertex; +z where the sum vanishes. load_mesh uses them where a file has no normals, and a
 /// deforming mesh recomputes them every frame.
