@@ -1,4 +1,6 @@
-// `lucent bench`: the speed/accuracy sweeps (docs/DESIGN.md §8), written to notebooks_data/bench/.
+// `lucent bench`: the speed/accuracy sweeps (docs/DESIGN.md §8), written to the folder given
+// (--out-dir, --out; default the current folder: notebooks_data/bench/ holds the shipped runs,
+// which a run elsewhere must not overwrite).
 #include <cstdio>
 #include <iostream>
 #include <memory>

@@ -26,6 +26,7 @@
 #include "lucent/render/tone_map.h"
 #include "progress.h"
 #include "scene_options.h"
+#include "shader_cache.h"
 #include "technique_flags.h"
 
 namespace lucent::cli {
@@ -150,6 +151,7 @@ void run_render(RenderArguments& render_args) {
   if (!render_args.stats.empty()) check_output_file(render_args.stats, ".json", "--stats");
   parse_budget(render_args.budget);
   Scene scene = build_scene(args).scene;
+  use_shader_cache();
   const auto start = std::chrono::steady_clock::now();
 
   const TechniqueInfo& technique = technique_info(args.technique_id);

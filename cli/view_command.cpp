@@ -1,6 +1,7 @@
 // `lucent view`: the same scene options as `lucent render`, shown in a window with live controls
 // (lucent::render::run_viewer). Needs an X display; `xvfb-run -a lucent view ...` gives a virtual
 // one.
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include "lucent/core/error.h"
 #include "progress.h"
 #include "scene_options.h"
+#include "shader_cache.h"
 #include "technique_flags.h"
 #include "validators.h"
 #if LUCENT_HAS_VIEWER
@@ -32,11 +34,11 @@ struct ViewArguments {
 
 void run_view(ViewArguments& args) {
 #if LUCENT_HAS_VIEWER
+  const auto started = std::chrono::steady_clock::now();
   if (!(args.deform >= 0 && args.deform <= 0.2f)) {
     throw Error("--deform: expected an amplitude in [0, 0.2] (fraction of the object's size)");
   }
-  // The maps' shader cache is of no use for one short session and fails on read-only homes.
-  setenv("MESA_SHADER_CACHE_DISABLE", "true", 0);
+  use_shader_cache();
   const bool model_given = !args.scene.model.empty();
   StageProgress progress("view", false);
   progress.stage("loading the scene (mesh, material, lights)", 0.0);
@@ -61,6 +63,7 @@ void run_view(ViewArguments& args) {
   options.hide_panel = args.hide_panel;
   options.frame_budget_ms = args.frame_budget_ms;
   options.fixed = args.fixed;
+  options.started = started;
   options.auto_exposure = args.scene.auto_exposure;
   if (!args.scene.default_rig.empty()) {
     std::string rig;

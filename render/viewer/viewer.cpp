@@ -107,11 +107,22 @@ int Viewer::run() {
       "accumulated %d of %d frames\n",
       frames_drawn_, frames_rendered_, restarts_, screenshots_,
       technique_info(technique_).name.c_str(), maps_frames(), running.frames);
+  std::printf("view: quality level %d of %d (%s) for a frame budget of %g ms\n", level_ + 1,
+              int(maps_quality_ladder(settings_, fixed_).size()), quality_text(running).c_str(),
+              frame_budget_ms_);
+  // How the window answered: the first image from the command's start, and the frames that
+  // rendered after it (input is read once a frame): median, 95th percentile, longest.
+  std::vector<double> busy = busy_frame_ms_;
+  std::sort(busy.begin(), busy.end());
+  const auto at = [&](double q) {
+    return busy.empty() ? 0.0
+                        : busy[std::min(busy.size() - 1, std::size_t(q * double(busy.size())))];
+  };
   std::printf(
-      "view: quality level %d of %d (%s) for a frame budget of %g ms; longest frame "
-      "%.0f ms after the first second\n",
-      level_ + 1, int(maps_quality_ladder(settings_, fixed_).size()), quality_text(running).c_str(),
-      frame_budget_ms_, max_frame_ms_);
+      "view: first image after %.2f s; %zu frames rendered after it: median %.0f ms, 95%% "
+      "within %.0f ms, longest %.0f ms, %ld over 100 ms\n",
+      first_image_s_, busy.size(), at(0.5), at(0.95), busy.empty() ? 0.0 : busy.back(),
+      long(std::count_if(busy.begin(), busy.end(), [](double ms) { return ms > 100; })));
   std::printf("view: panel %s, widest line %.0f of %.0f px\n",
               !show_ui_          ? "hidden"
               : panel_collapsed_ ? "folded"
@@ -124,8 +135,7 @@ void Viewer::frame() {
   const double now = glfwGetTime();
   frame_ms_ = 1000 * (now - last_time_);
   last_time_ = now;
-  if (now - start_time_ > 1.0 && frames_rendered_ > 2)
-    max_frame_ms_ = std::max(max_frame_ms_, frame_ms_);
+  if (first_image_s_ > 0 && rendered_last_frame_) busy_frame_ms_.push_back(frame_ms_);
   int w = 0, h = 0;
   glfwGetFramebufferSize(window_, &w, &h);
   if (w > 0 && h > 0 && (w != width_ || h != height_)) {

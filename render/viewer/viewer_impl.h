@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
@@ -336,7 +337,11 @@ class Viewer {
   float render_scale_ = 1, refine_scale_ = 1;
   bool redraw_ = true;                    // something changed since the last rendered frame
   bool exposure_pending_frames_ = false;  // auto exposure waits for a few accumulated frames
-  double max_frame_ms_ = 0;  // the longest window frame after the first second (the summary)
+  // How the window answered (the summary): when the first image was shown, s from the command's
+  // start, and each frame that rendered since, ms.
+  double first_image_s_ = 0;
+  std::vector<double> busy_frame_ms_;
+  bool rendered_last_frame_ = false;
   double start_time_ = 0;
   // The panel: docked at the left; its width as the person left it (0 when folded or hidden), and
   // the widest line it holds (a label wider than the panel would be clipped).

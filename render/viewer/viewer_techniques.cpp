@@ -84,7 +84,8 @@ void Viewer::draw_technique() {
     // is presented again (the maps took 17 s a frame, forever, after converging).
     const bool converged = t->converged();
     const bool animated = deformer_ || (technique_ == TechniqueId::kFur && fur_lobe_);
-    if (!converged || redraw_ || animated) {
+    rendered_last_frame_ = !converged || redraw_ || animated;
+    if (rendered_last_frame_) {
       t->render_frame();
       ++frames_rendered_;
       redraw_ = false;
@@ -138,6 +139,11 @@ void Viewer::draw_technique() {
     }
     const ViewRect r = view_rect();
     shown->present(settings_.exposure, r.x, r.y, r.width, r.height);
+    if (first_image_s_ == 0 && shown->frame_stats().frames > 0) {
+      first_image_s_ =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - options_.started)
+              .count();
+    }
   }
 }
 

@@ -9,7 +9,7 @@
 namespace lucent::fit {
 
 struct FitBenchOptions {
-  std::filesystem::path out_dir = "notebooks_data/bench";  ///< fit_tradeoff.csv and .png go here
+  std::filesystem::path out_dir = ".";  ///< fit_tradeoff.csv and .png go here (--out-dir)
   std::filesystem::path sample_capture = "notebooks_data/captures/marble_0deg/capture.json";
   int repeats = 5;   ///< timed fits per setting; the median is reported
   int size_px = 64;  ///< simulated captures' size

@@ -1,6 +1,6 @@
 // `lucent bench render`: per-stage times of the radiance-map technique at the seed's settings on
-// the bunny and the dragon at several resolutions (Dal Corso 2014, Figure 6.15), to
-// notebooks_data/bench/.
+// the bunny and the dragon at several resolutions (Dal Corso 2014, Figure 6.15), to a CSV in the
+// current folder or --out (notebooks_data/bench/ holds the shipped runs).
 #pragma once
 
 #include <filesystem>
@@ -13,7 +13,7 @@
 namespace lucent::render {
 
 struct RenderBenchOptions {
-  std::filesystem::path out_csv = "notebooks_data/bench/render.csv";
+  std::filesystem::path out_csv = "render.csv";  ///< --out (default: the current folder)
   std::vector<std::string> meshes = {"bunny", "dragon:4", "dragon:3", "dragon:2"};
   RenderSettings settings;   ///< defaults: the seed's K = 16, W_s = W_l = 512, N = 50, M = 1000
   /// One row per mesh and selection: strata gathers far disc points, whose scattered light-map
@@ -33,7 +33,7 @@ int run_render_bench(const RenderBenchOptions& options, std::ostream& log);
 /// first, compiling frame), from the render command's default view (30, 20: the tile on part of the
 /// frame) and from close by (the frame filled), with the fraction of pixels the fur covers.
 struct FurBenchOptions {
-  std::filesystem::path out_csv = "notebooks_data/bench/fur.csv";
+  std::filesystem::path out_csv = "fur.csv";  ///< --out (default: the current folder)
   std::vector<int> shells = {16, 32, 64};  ///< the seed's 32 and a halving and doubling
   int texels = 64;                         ///< the seed's tile, texels across
   std::vector<float> distances = {3.4f, 1.6f};  ///< camera distances, bounding radii

@@ -27,7 +27,7 @@ enum class TradeoffTruth { kPathtrace, kReference };
 TradeoffTruth parse_tradeoff_truth(const std::string& text);
 
 struct TradeoffBenchOptions {
-  std::filesystem::path out_dir = "notebooks_data/bench";
+  std::filesystem::path out_dir = ".";  ///< --out-dir (default: the current folder)
   /// MESH/MATERIAL/LIGHTING[/SIZE_MM], LIGHTING one of directional, point, env (a procedural sky
   /// of `env_lights` importance-sampled lights), SIZE_MM the object's size (default 100). The first
   /// scene gets the full sweep. Every technique renders as the CLI does by default: the single

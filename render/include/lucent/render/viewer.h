@@ -16,6 +16,7 @@
 // while the maps refine, and nothing is rendered once they have converged.
 #pragma once
 
+#include <chrono>
 #include <string>
 
 #include "lucent/render/frame_budget.h"
@@ -66,6 +67,8 @@ struct ViewerOptions {
   /// 0: the knobs as given, whatever a frame costs.
   double frame_budget_ms = 50;
   FixedKnobs fixed;            ///< the maps' knobs given on the command line (and then the panel's)
+  /// When the command started (the summary's "first image after S s").
+  std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
   bool auto_exposure = false;  ///< --exposure auto: set once from the first images (tone_map.h)
 };
 
