@@ -145,6 +145,11 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
   cmd->add_option("--backdrop", args->backdrop,
                   "R,G,B: radiance of the background where there is no environment map "
                   "(default black)");
+  cmd->add_option("--ground", args->ground,
+                  "off, on (albedo 0.5) or R,G,B albedo in [0, 1]: a Lambertian ground plane under "
+                  "the object, lit by the point and directional lights and an environment's, "
+                  "shadowed by the object (--technique maps, and the viewer's maps)")
+      ->capture_default_str();
   cmd->add_option("--seed", args->options.reference.seed,
                   "random seed (reference samples, environment-light placement)")
       ->check(seed_value())
@@ -259,6 +264,23 @@ void check_options(SceneArguments& args, const render::TechniqueInfo& technique)
   }
 }
 
+std::optional<render::Vec3f> parse_ground(const SceneArguments& args) {
+  if (args.ground == "off") return std::nullopt;
+  render::Vec3f albedo(0.5f, 0.5f, 0.5f);
+  if (args.ground != "on") {
+    const auto a = parse_numbers(args.ground, "--ground", 3, ',', "off, on or R,G,B albedo");
+    for (double v : a)
+      if (!(v >= 0 && v <= 1))
+        throw Error("--ground: expected off, on or R,G,B albedo in [0, 1], got '" + args.ground +
+                    "'");
+    albedo = render::Vec3f(float(a[0]), float(a[1]), float(a[2]));
+  }
+  if (args.technique_id != render::TechniqueId::kMaps)
+    throw Error("--ground: drawn by the maps only (--technique maps), got --technique " +
+                args.technique);
+  return albedo;
+}
+
 render::Vec3f parse_backdrop(const SceneArguments& args) {
   using render::Vec3f;
   Vec3f backdrop = Vec3f::Zero();
@@ -312,6 +334,7 @@ SceneSetup build_scene(SceneArguments& args) {
   check_options(args, technique);
   TechniqueOptions& o = args.options;
   const Vec3f backdrop = parse_backdrop(args);
+  const std::optional<Vec3f> ground = parse_ground(args);
   std::optional<EnvironmentArgument> env;
   const std::vector<Light> lights = parse_lights(args, view[0], env);
 
@@ -341,6 +364,7 @@ SceneSetup build_scene(SceneArguments& args) {
   scene.angular = args.angular == "on";
   scene.geometry_factor = args.geometry_factor == "on";
   scene.backdrop = backdrop;
+  scene.ground = ground;
   if (args.fur_coat == "on")
     scene.fur_coat = render::fur::make_fur_coat(render::fur::over_mesh(o.fur));
   scene.camera = orbit_camera(scene.mesh, float(view[0]), float(view[1]), float(view[2]),

@@ -39,6 +39,7 @@ struct SceneArguments {
   std::string angular = "on";              ///< --angular on|off
   std::string geometry_factor = "on";      ///< --geometry-factor on|off
   std::string backdrop;                  ///< R,G,B radiance; empty: black
+  std::string ground = "off";            ///< --ground off|on|R,G,B albedo
   std::vector<std::string> default_rig;  ///< set by build_scene: the lights used when none given
   /// Every technique's options, filled by their flag groups (technique_flags.h); --seed writes
   /// options.reference.seed, build_scene the model and the exposure into options.settings.

@@ -173,6 +173,16 @@ void Viewer::draw_scene_controls() {
   float size = float(object_size_mm_);
   ImGui::SliderFloat("object size mm", &size, 1.0f, 2000.0f, "%.4g", ImGuiSliderFlags_Logarithmic);
   if (slider_done()) set_object_size(size);
+  bool ground = scene_.ground.has_value();
+  if (ImGui::Checkbox("ground", &ground)) {
+    // A Lambertian plane under the object, shadowed by it (the maps draw it).
+    if (ground) {
+      scene_.ground = Vec3f(0.5f, 0.5f, 0.5f);
+    } else {
+      scene_.ground.reset();
+    }
+    rebuild_maps();  // its program is built with the maps' (the levels set up before drop)
+  }
   float deform = deform_amplitude_;
   ImGui::SliderFloat("deform", &deform, 0.0f, 0.2f, "%.3f");
   if (slider_done()) set_deform(deform);

@@ -10,6 +10,9 @@ lucent_add_test(radiance_maps_test
 lucent_add_test(radiance_maps_split_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/radiance_maps_split_test.cpp
   LIBS lucent::render lucent::materials OpenGL::OpenGL)
+lucent_add_test(ground_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/ground_test.cpp
+  LIBS lucent::render lucent::materials OpenGL::OpenGL)
 lucent_add_test(faceted_mesh_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/faceted_mesh_test.cpp
   LIBS lucent::render lucent::materials OpenGL::OpenGL)
@@ -40,7 +43,7 @@ lucent_add_test(oblique_skew_test
 # White-box: both include private headers of render/ (gl_program.h, gl_bssrdf.h,
 # radiance_maps_sampling.h).
 foreach(t glsl_twin_test geometry_factor_test oblique_skew_test radiance_maps_test
-          radiance_maps_split_test sh_renderer_test area_light_test fur_glsl_twin_test
+          radiance_maps_split_test ground_test sh_renderer_test area_light_test fur_glsl_twin_test
           fur_renderer_test)
   target_include_directories(${t} PRIVATE ${LUCENT_RENDER_PRIVATE_DIRS})
 endforeach()

@@ -168,6 +168,10 @@ void RadianceMapRenderer::Impl::build_programs() {
                              defines);
   final_program =
       gl::Program({{GL_VERTEX_SHADER, "final.vert"}, {GL_FRAGMENT_SHADER, "final.frag"}}, defines);
+  if (scene.ground) {
+    ground_program = gl::Program(
+        {{GL_VERTEX_SHADER, "ground.vert"}, {GL_FRAGMENT_SHADER, "ground.frag"}}, defines);
+  }
 
   const auto unit = [](const gl::Program& p, const char* name, GLint u) {
     glProgramUniform1i(p.id(), p.location(name), u);
@@ -334,6 +338,14 @@ void RadianceMapRenderer::Impl::upload_light_cameras(int t) {
   glProgramUniform4fv(f, final_program.location("u_light_position"), kMaxLights, position.data());
   glProgramUniform3fv(f, final_program.location("u_light_radiance"), kMaxLights, radiance_.data());
   glProgramUniform2fv(f, final_program.location("u_light_texel_mm"), kMaxLights, texel.data());
+  if (scene.ground) {
+    const GLuint g = ground_program.id();
+    glProgramUniform1i(g, ground_program.location("u_light_count"), L);
+    glProgramUniform4fv(g, ground_program.location("u_light_position"), kMaxLights,
+                        position.data());
+    glProgramUniform3fv(g, ground_program.location("u_light_radiance"), kMaxLights,
+                        radiance_.data());
+  }
 }
 
 void RadianceMapRenderer::Impl::upload_disc(int t, bool redraw) {
@@ -516,6 +528,7 @@ void RadianceMapRenderer::Impl::render_blur() {
 void RadianceMapRenderer::Impl::render_final() {
   const detail::Mat4f view_proj = detail::camera_view_proj(scene.camera, centre, radius_mm);
   final.begin_frame(view_proj, scene.backdrop);
+  if (scene.ground) render_ground(view_proj);
 
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
@@ -549,6 +562,32 @@ void RadianceMapRenderer::Impl::render_final() {
   glBindTextureUnit(kUnitRadianceDepth, radiance_depth.id());
   glBindSampler(kUnitRadianceDepth, shadow.id());
   mesh.draw();
+}
+
+// The ground under the object (ground.frag), drawn after the background and before the object. With
+// the eye above the plane no ray to the object crosses the ground, so it needs no depth test; depth
+// clamping keeps it beyond the far plane (the camera's depth range is the object's).
+void RadianceMapRenderer::Impl::render_ground(const detail::Mat4f& view_proj) {
+  const float floor_mm = scene.mesh.bounds_min().y();
+  if (scene.camera.eye.y() <= floor_mm) return;  // seen from below: no ground
+  ground_program.use();
+  const Vec3f ground_centre(centre.x(), floor_mm, centre.z());
+  glUniformMatrix4fv(ground_program.location("u_view_proj"), 1, GL_FALSE, view_proj.data());
+  glUniform3fv(ground_program.location("u_ground_centre"), 1, ground_centre.data());
+  glUniform1f(ground_program.location("u_ground_half_mm"), 6 * radius_mm);
+  glUniform1f(ground_program.location("u_object_radius_mm"), radius_mm);
+  glUniform3fv(ground_program.location("u_ground_albedo"), 1, scene.ground->data());
+  glUniform1i(ground_program.location("u_light_positions"), kUnitLightPositionsFinal);
+  glBindBufferBase(GL_UNIFORM_BUFFER, kLightMatricesBinding, light_matrices.id());
+  glBindTextureUnit(kUnitLightPositionsFinal, light_positions.id());
+  glBindSampler(kUnitLightPositionsFinal, nearest.id());
+  glDisable(GL_DEPTH_TEST);
+  glDepthMask(GL_FALSE);
+  glEnable(GL_DEPTH_CLAMP);
+  glBindVertexArray(empty_vao.id());
+  glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+  glDisable(GL_DEPTH_CLAMP);
+  glDepthMask(GL_TRUE);
 }
 
 std::vector<float> RadianceMapRenderer::Impl::read_rgba() const {

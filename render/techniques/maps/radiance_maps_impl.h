@@ -74,6 +74,7 @@ struct RadianceMapRenderer::Impl {
   gl::VertexArray empty_vao;
 
   gl::Program light_map_program, radiance_program, blur_program, final_program;
+  gl::Program ground_program;  // the ground plane (Scene::ground)
 
   gl::Buffer light_matrices, layer_cameras, disc_buffer;
   gl::Texture light_positions, light_normals, light_face_normals, light_depth;
@@ -126,6 +127,7 @@ struct RadianceMapRenderer::Impl {
   void render_radiance(int t, int first, int count);
   void render_blur();
   void render_final();
+  void render_ground(const detail::Mat4f& view_proj);
   template <typename F>
   void timed(int stage, F&& work);
   std::vector<float> read_rgba() const;

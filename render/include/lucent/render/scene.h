@@ -98,6 +98,10 @@ struct Scene {
   /// default; a Scene made in code has the planar profile alone.
   bool geometry_factor = false;
   Vec3f backdrop{0, 0, 0};  ///< radiance of the background where no environment map is given
+  /// `--ground`: a Lambertian ground plane of this albedo (RGB in [0, 1]) under the object, lit by
+  /// the point and directional lights (an environment's too) and shadowed by the object. The maps
+  /// draw it (render and view); not part of the object (its pixels are outside the mask).
+  std::optional<Vec3f> ground;
   /// A fur coat over the skin (fur_coat.h, an extension of Klotzli & Olano): the maps and the
   /// reference attenuate each light sample's transmitted irradiance by its T(n . w_i). `--fur-coat
   /// on`.
