@@ -81,12 +81,16 @@ class ProgressLine {
 /// first second. Thread-safe.
 class StageProgress {
  public:
-  StageProgress(std::string what, bool quiet)
+  /// `heartbeat`: away from a terminal, also a line after the first second and then every ten
+  /// ("render: rendering (hierarchical boundary elements), 11 s so far") for a stage that has no
+  /// share to report (a technique's set-up).
+  StageProgress(std::string what, bool quiet, bool heartbeat = false)
       : what_(std::move(what)),
         quiet_(quiet),
         terminal_(::isatty(STDERR_FILENO) != 0),
+        heartbeat_(heartbeat),
         start_(std::chrono::steady_clock::now()) {
-    if (!quiet_ && terminal_) ticker_ = std::thread([this] { tick(); });
+    if (!quiet_ && (terminal_ || heartbeat_)) ticker_ = std::thread([this] { tick(); });
   }
   ~StageProgress() { finish(); }
   StageProgress(const StageProgress&) = delete;
@@ -121,9 +125,18 @@ class StageProgress {
   }
   void tick() {
     std::unique_lock<std::mutex> lock(mutex_);
+    double next_line = 1;
     while (!wake_.wait_for(lock, std::chrono::seconds(1), [this] { return stopped_; })) {
       if (stage_.empty()) continue;
       const double t = elapsed();
+      if (!terminal_) {
+        if (t + 0.5 < next_line) continue;
+        next_line = t < 5 ? 10 : next_line + 10;
+        std::fprintf(stderr, "%s: %s, %s so far\n", what_.c_str(), stage_.c_str(),
+                     duration_text(t).c_str());
+        std::fflush(stderr);
+        continue;
+      }
       const std::string left =
           done_ > 0.02 ? ", " + duration_text(t * (1 - done_) / done_) + " left" : "";
       std::fprintf(stderr, "\r%s: %s, %d%%%s   ", what_.c_str(), stage_.c_str(), int(100 * done_),
@@ -134,7 +147,7 @@ class StageProgress {
   }
 
   std::string what_;
-  bool quiet_, terminal_;
+  bool quiet_, terminal_, heartbeat_;
   std::chrono::steady_clock::time_point start_;
   std::mutex mutex_;
   std::condition_variable wake_;

@@ -182,11 +182,12 @@ void run_render(RenderArguments& render_args) {
   const bool budgeted = args.technique_id == TechniqueId::kMaps && render_args.snapshots.empty();
   std::vector<std::string> written;  // removed again if a later stage fails
   ImageRgb image;
-  // The frame-by-frame techniques other than the maps: a ticker of the time so far on a terminal
-  // (their set-up, the hierarchical links above all, has no share to report).
+  // The frame-by-frame techniques other than the maps: the time so far (their set-up, the
+  // hierarchical links above all, has no share to report), on a terminal a ticker, elsewhere a
+  // line after a second and every ten.
   std::unique_ptr<StageProgress> stages;
   if (!budgeted && technique.gpu) {
-    stages = std::make_unique<StageProgress>("render", false);
+    stages = std::make_unique<StageProgress>("render", false, true);
     stages->stage("rendering (" + technique.label + ")", 0);
   }
   try {

@@ -43,6 +43,26 @@ TEST(Progress, DurationText) {
   EXPECT_EQ(duration_text(-3), "0 s");
 }
 
+// A stage with no share to report (render's hierarchical links): with the heartbeat, a line after
+// the first second away from a terminal, and none before it.
+TEST(Progress, AHeartbeatSaysALongStageIsAlive) {
+  const std::string quick = captured_stderr([] {
+    StageProgress progress("render", false, true);
+    progress.stage("rendering (hierarchical)", 0.0);
+    progress.finish();
+  });
+  EXPECT_EQ(quick, "");
+  const std::string text = captured_stderr([] {
+    StageProgress progress("render", false, true);
+    progress.stage("rendering (hierarchical)", 0.0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1600));
+    progress.finish();
+  });
+  EXPECT_NE(text.find("render: rendering (hierarchical), 1 s so far\n"), std::string::npos) << text;
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << text;
+  EXPECT_EQ(text.find('\r'), std::string::npos) << text;
+}
+
 TEST(Progress, StagesAfterTheFirstSecondGetOneLineEach) {
   const std::string text = captured_stderr([] {
     StageProgress progress("acquire", false);
