@@ -43,7 +43,7 @@ void register_acquire_command(CLI::App& app) {
   cmd->add_option("--bins", args->options.bins,
                   "number of radial bins from 0 to the radius (default 150); bins with too few "
                   "pixels are dropped")
-      ->check(whole_in(1, 1000000, "radial bins"));
+      ->transform(whole_in(1, 1000000, "radial bins"));
   cmd->add_flag("--log-bins", args->options.log_bins,
                 "log-spaced bins from half a pixel pitch to the radius (first bin [0, pitch/2))");
   auto* radius = cmd->add_option("--radius-mm", args->radius_mm,
@@ -53,7 +53,7 @@ void register_acquire_command(CLI::App& app) {
   cmd->add_option(
          "--min-pixels", args->options.min_pixels_per_bin,
          "drop radial bins with fewer unmasked pixels than this in any channel (default 3)")
-      ->check(whole_in(2, 1000000000, "pixels per bin"));
+      ->transform(whole_in(2, 1000000000, "pixels per bin"));
   cmd->add_flag("--json", args->json, "print the summary as JSON on standard output");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress on standard error");
   cmd->callback([args, radius] {

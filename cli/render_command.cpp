@@ -4,6 +4,7 @@
 // input fails fast and leaves no output file.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -88,8 +89,10 @@ struct Written {
 };
 
 // Every output from one linear image: PNG with the exposure (auto: the image's own), EXR linear.
+// Each path written goes into `written` (removed again if a later one fails).
 Written write_outputs(const RenderArguments& render_args, const render::ImageRgb& image,
-                      const render::Scene& scene, const std::string& technique) {
+                      const render::Scene& scene, const std::string& technique,
+                      std::vector<std::string>& written) {
   render::ToneMapOptions tone;
   tone.exposure = render_args.scene.auto_exposure ? render::auto_exposure(image)
                                                   : render_args.scene.options.settings.exposure;
@@ -99,6 +102,7 @@ Written write_outputs(const RenderArguments& render_args, const render::ImageRgb
                                 {"lucent:material", scene.material.name},
                                 {"lucent:mesh", scene.mesh.name},
                                 {"lucent:technique", technique}});
+    if (std::find(written.begin(), written.end(), path) == written.end()) written.push_back(path);
   }
   return {tone.exposure};
 }
@@ -107,14 +111,15 @@ Written write_outputs(const RenderArguments& render_args, const render::ImageRgb
 render::ImageRgb render_maps_budgeted(RenderArguments& render_args, const render::Scene& scene,
                                       const render::TechniqueOptions& options,
                                       ProgressLine& progress, render::RenderStats& stats,
-                                      nlohmann::json& budget_doc) {
+                                      nlohmann::json& budget_doc,
+                                      std::vector<std::string>& written) {
   using namespace lucent::render;
   BudgetedMapsOptions budget;
   budget.ladder = maps_quality_ladder(options.settings, render_args.fixed);
   budget.budget_s = parse_budget(render_args.budget);
   const auto start = std::chrono::steady_clock::now();
   budget.on_image = [&](const ImageRgb& image, int level) {
-    write_outputs(render_args, image, scene, "radiance maps");
+    write_outputs(render_args, image, scene, "radiance maps", written);
     progress.finish();
     const double t =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -135,6 +140,7 @@ render::ImageRgb render_maps_budgeted(RenderArguments& render_args, const render
                 {"levels", budget.ladder.size()},
                 {"level", result.level},
                 {"levels_run", result.levels_run},
+                {"levels_given_up", result.levels_given_up},
                 {"level_seconds", result.level_seconds},
                 {"quality", quality_text(used)},
                 {"requested", quality_text(requested)},
@@ -180,7 +186,8 @@ void run_render(RenderArguments& render_args) {
   RenderStats stats;
   nlohmann::json budget_doc;
   const bool budgeted = args.technique_id == TechniqueId::kMaps && render_args.snapshots.empty();
-  std::vector<std::string> written;  // removed again if a later stage fails
+  std::vector<std::string>
+      written;  // the coarse and refined images: removed if a later stage fails
   ImageRgb image;
   // The frame-by-frame techniques other than the maps: the time so far (their set-up, the
   // hierarchical links above all, has no share to report), on a terminal a ticker, elsewhere a
@@ -190,22 +197,21 @@ void run_render(RenderArguments& render_args) {
     stages = std::make_unique<StageProgress>("render", false, true);
     stages->stage("rendering (" + technique.label + ")", 0);
   }
+  Written out;
   try {
-    image = budgeted
-                ? render_maps_budgeted(render_args, scene, options, progress, stats, budget_doc)
-                : render_still(args.technique_id, scene, options, &stats);
+    image = budgeted ? render_maps_budgeted(render_args, scene, options, progress, stats,
+                                            budget_doc, written)
+                     : render_still(args.technique_id, scene, options, &stats);
+    progress.finish();
+    stages.reset();
+    out = write_outputs(render_args, image, scene, technique.name, written);
   } catch (...) {
     progress.finish();
     stages.reset();
-    if (budgeted) {
-      std::error_code ignored;
-      for (const std::string& path : render_args.outputs) std::filesystem::remove(path, ignored);
-    }
+    std::error_code ignored;
+    for (const std::string& path : written) std::filesystem::remove(path, ignored);
     throw;
   }
-  progress.finish();
-  stages.reset();
-  const Written out = write_outputs(render_args, image, scene, technique.name);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   bool png = false;

@@ -152,7 +152,7 @@ void add_scene_options(CLI::App* cmd, SceneArguments& args_, const std::string& 
       ->capture_default_str();
   cmd->add_option("--seed", args->options.reference.seed,
                   "random seed (reference samples, environment-light placement)")
-      ->check(seed_value())
+      ->transform(seed_value())
       ->capture_default_str();
   cmd->add_option(
          "--fur-coat", args->fur_coat,

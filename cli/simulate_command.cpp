@@ -244,13 +244,13 @@ void add_subject_options(CLI::App* cmd, SimulateArguments& args) {
 // Photon transport: photons, seed, threads, the slab and the beam's width.
 void add_transport_options(CLI::App* cmd, acquire::SimulateOptions& o) {
   cmd->add_option("--photons", o.transport.photons, "photons per colour channel")
-      ->check(whole_in(100, 1000000000000000ull, "photons per channel"))
+      ->transform(whole_in(100, 1000000000000000ull, "photons per channel"))
       ->capture_default_str();
   cmd->add_option("--seed", o.transport.seed, "random seed (results identical for any --threads)")
-      ->check(seed_value())
+      ->transform(seed_value())
       ->capture_default_str();
   cmd->add_option("--threads", o.transport.threads, "worker threads (0 = all cores)")
-      ->check(thread_count())
+      ->transform(thread_count())
       ->capture_default_str();
   cmd->add_option("--thickness-mm", o.transport.thickness_mm,
                   "slab thickness in mm (default: semi-infinite)");
@@ -315,7 +315,7 @@ FieldOptions add_field_options(CLI::App* cmd, acquire::SimulateOptions& o) {
                                "image width and height, pixels (default: the field holds 3.5 "
                                "diffusion lengths of the slowest channel each side of the beam, "
                                "at most 1024 pixels)")
-                   ->check(whole_in(1, 16384, "an image size in pixels"));
+                   ->transform(whole_in(1, 16384, "an image size in pixels"));
   field.pixel =
       cmd->add_option("--pixel-mm", o.transport.pixel_mm,
                       "pixel pitch on the sample, mm (default: a quarter of the shortest transport "
@@ -341,7 +341,7 @@ void add_camera_options(CLI::App* cmd, SimulateArguments& args) {
                   "RAW codes with black level, exposure time and ISO in each file)")
       ->capture_default_str();
   cmd->add_option("--bits", o.camera.bits, "bits per channel: 8 or 16")
-      ->check(whole_in(8, 16, "bits per channel (8 or 16)"))
+      ->transform(whole_in(8, 16, "bits per channel (8 or 16)"))
       ->capture_default_str();
   cmd->add_option("--full-well-e", o.camera.full_well_e, "electrons at saturation")
       ->check(number_in(100, 1e9, "electrons"))

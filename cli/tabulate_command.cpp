@@ -127,10 +127,11 @@ void register_tabulate_command(CLI::App& app) {
                   "photons of the white run (alpha' >= 0.4) per slice, fewer than --photons to "
                   "make high-g slices affordable (default: --photons)");
   cmd->add_option("--seed", o.seed, "random seed (same table for any --threads or sharding)")
-      ->check(seed_value())
+      ->transform(seed_value())
       ->capture_default_str();
   cmd->add_option("--threads", o.threads, "worker threads (0 = all cores)")
-      ->check(thread_count())->capture_default_str();
+      ->transform(thread_count())
+      ->capture_default_str();
   cmd->add_option("--groups", o.groups, "independent photon groups per slice (standard errors)")
       ->capture_default_str();
   cmd->add_option("--max-path", o.max_path, "paths cut at this length, units of 1/sigma_s'")

@@ -42,11 +42,11 @@ CLI::Option* flag(CLI::App* cmd, CLI::App* g, const std::string& name, const std
   if (!alias.empty()) {
     CLI::Option* old =
         cmd->add_option(alias, target, "deprecated: " + name)->group(kDeprecatedGroup);
-    if (check) old->check(*check);
+    if (check) old->transform(*check);  // transform: whole_in rewrites 1e5 to its digits
     aliases().emplace_back(old, name);
   }
   CLI::Option* option = g->add_option(name, target, help)->capture_default_str();
-  if (check) option->check(*check);
+  if (check) option->transform(*check);
   return option;
 }
 
@@ -204,7 +204,7 @@ void add_fur_flags(CLI::App* cmd, render::fur::FurOptions& o) {
   flag(cmd, g, "--fur-texels", "", o.texels, "the tile's texels across (seed: 64)",
        whole_in(2, 4096, "fur texels"));
   flag(cmd, g, "--fur-shells", "", o.shells, "shells (seed: 32)", whole_in(1, 1024, "fur shells"));
-  flag(cmd, g, "--fur-seed", "", o.seed, "the hair generator's seed")->check(seed_value());
+  flag(cmd, g, "--fur-seed", "", o.seed, "the hair generator's seed")->transform(seed_value());
   choice(cmd, g, "--fur-coverage", "", o.coverage,
          named({CoverageRule::kExact, CoverageRule::kSeed}),
          "a hair's cross-section over the texels: exact (the disc's overlap with each texel) or "

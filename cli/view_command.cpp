@@ -112,10 +112,11 @@ void register_view_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--hide-panel", args->hide_panel, "start without the panel (H shows it)");
   cmd->add_option("--frame-budget-ms", args->frame_budget_ms,
-                  "maps: the time a frame may take (ms); the knobs not given (K, W_s, W_l, N, T) "
-                  "are chosen from the frames measured to keep within it, coarse first, and the "
-                  "image is rendered at a lower resolution while it refines if even the coarsest "
-                  "is over it; 0: the knobs as given, whatever a frame costs")
+                  "maps: the time a display frame may take (ms): the knobs not given (K, W_s, "
+                  "W_l, N, T) climb from a coarse level to the requested ones as each converges, "
+                  "each frame split across display frames to keep within it, at a lower "
+                  "resolution while it refines if the final pass alone is over 40% of it; 0: the "
+                  "knobs as given, whole frames, whatever a frame costs")
       ->check(number_in(0, 1e6, "ms", false))
       ->capture_default_str();
   cmd->add_option(

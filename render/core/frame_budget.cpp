@@ -101,10 +101,10 @@ double AffineCost::predict(double x) const {
     if (b >= 0 && a >= 0) return a + b * x;
     if (b > 0) return std::max(0.0, a + b * x);  // a < 0 within noise: still the measured slope
   }
-  // One amount of work (or a fit that came out negative): half of the largest measured time taken
-  // as fixed and half as growing with the work (on llvmpipe the fixed part of the coarse level's
-  // layer is 50-80%), which still over-predicts a larger x, the safe side of a budget, without
-  // ruling out every level above the first.
+  // One amount of work (or a fit that came out negative): above the point with the largest ratio,
+  // half of its time taken as fixed and half as growing with the work (on llvmpipe the fixed part
+  // of the coarse level's layer is 50-80%), which still over-predicts a larger x, the safe side of
+  // a budget, without ruling out every level above the first; below it, in proportion.
   double at = 0, ms = 0;
   for (const auto& [xi, yi] : samples_)
     if (yi / xi >= max_ratio) {
@@ -117,7 +117,10 @@ double AffineCost::predict(double x) const {
 void FrameCostModel::record(const MeasuredFrame& f) {
   const RenderSettings& s = f.settings;
   radiance_.record(layer_gathers(s), f.radiance_ms / std::max(1, s.directions));
-  light_.record(double(s.light_map_size) * s.light_map_size, f.light_ms / std::max(1, f.lights));
+  // Light maps drawn once a level (point and directional lights) are part of its set-up: only
+  // frames that drew them count them.
+  if (f.light_ms > 0)
+    light_.record(double(s.light_map_size) * s.light_map_size, f.light_ms / std::max(1, f.lights));
   final_.record(double(std::max(1, f.pixels)) * s.directions, f.final_ms);
   ++frames_;
 }
@@ -195,6 +198,7 @@ ImageBudgetRun run_image_budget(const std::vector<RenderSettings>& ladder, doubl
     run.levels_run.push_back(level);
     if (abandoned) {
       ceiling = level;
+      run.levels_given_up.push_back(level);
     } else {
       done = level;
     }

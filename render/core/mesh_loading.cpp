@@ -351,11 +351,14 @@ std::size_t crease_normals(Mesh& mesh, double crease_angle_deg) {
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
       for (unsigned f : around[id[v]]) {
         const double length = face[f].norm();
-        if (own_length > 0 && length > 0 &&
-            face[t].dot(face[f]) >= cos_crease * own_length * length)
+        // Its own face always (at 0 degrees rounding put a face outside its own cone).
+        if (f == t || (own_length > 0 && length > 0 &&
+                       face[t].dot(face[f]) >= cos_crease * own_length * length))
           sum += face[f];
       }
-      const Vec3f n = sum.norm() > 0 ? Vec3f(sum.normalized().cast<float>()) : Vec3f(0, 0, 1);
+      const Vec3f n = sum.norm() > 0   ? Vec3f(sum.normalized().cast<float>())
+                      : own_length > 0 ? Vec3f(face[t].normalized().cast<float>())
+                                       : Vec3f(0, 0, 1);
       auto& copies = made[v];
       const auto same = std::find_if(copies.begin(), copies.end(), [&](const auto& c) {
         return (c.first - n).squaredNorm() < 1e-10f;

@@ -92,7 +92,8 @@ int Viewer::run() {
     // and, now and then, to watch the material file.
     const Technique* t = live(technique_);
     const bool busy = !on_cpu() && (t == nullptr || !t->converged() || redraw_ || deformer_ ||
-                                    render_scale_ < 1 || auto_exposure_ ||
+                                    (technique_ == TechniqueId::kMaps && render_scale_ < 1) ||
+                                    (auto_exposure_ && !show_difference_) ||
                                     (technique_ == TechniqueId::kFur && fur_lobe_));
     if (busy) {
       glfwPollEvents();
@@ -320,7 +321,10 @@ void Viewer::scene_changed() {
   redraw_ = true;
   for (LiveTechnique& t : live_)
     if (t.technique) t.technique->restart();
-  // The maps climb their levels again from the coarse one (set up before: no compiling).
+  // The maps climb their levels again from the coarse one (set up before: no compiling); every
+  // level parked restarts too (R, or a change none of them can see).
+  for (LiveTechnique& parked : parked_maps_)
+    if (parked.technique) parked.technique->restart();
   if (frame_budget_ms_ > 0 && level_ > 0 && live(TechniqueId::kMaps) != nullptr) {
     switch_maps_level(0);
     live(TechniqueId::kMaps)->restart();

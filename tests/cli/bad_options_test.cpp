@@ -33,6 +33,10 @@ std::vector<BadCase> option_cases() {
       {"sim_seed_fraction", nullptr, sim + "--seed 1.5", "--seed"},
       {"sim_seed_too_big", nullptr, sim + "--seed 18446744073709551616", "--seed"},
       {"sim_photons_one", nullptr, sim + "--photons 1", "--photons"},
+      {"sim_photons_fraction_exponent", nullptr, sim + "--photons 1e3.5", "--photons"},
+      {"sim_photons_fraction_left", nullptr, sim + "--photons 1.05e1", "--photons"},
+      {"sim_photons_negative_exponent", nullptr, sim + "--photons 1e-3", "--photons"},
+      {"sim_seed_exponent_overflow", nullptr, sim + "--seed 1e40", "--seed"},
       {"sim_threads_huge", nullptr, sim + "--threads 100000", "--threads"},
       {"sim_threads_negative", nullptr, sim + "--threads -1", "--threads"},
       {"sim_size_zero", nullptr, sim + "--size 0", "--size"},
@@ -219,6 +223,17 @@ TEST(Outputs, AnExistingFolderIsReplacedWholeOnlyWithForce) {
   for (const auto& e : fs::directory_iterator(dir)) {
     EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
   }
+  fs::remove_all(dir);
+}
+
+// A whole number may be typed with an exponent (--photons 1e5 read as arbitrary when refused).
+TEST(Outputs, WholeNumbersTakeAnExponent) {
+  const fs::path dir = scratch_dir("exponent");
+  const CommandResult r = run_lucent(
+      "simulate --material marble --photons 2.5e3 --size 16 --quiet -o " + quoted(dir / "s"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto truth = nlohmann::json::parse(read_bytes(dir / "s/truth.json"));
+  EXPECT_EQ(truth["transport"]["photons_per_channel"], 2500);
   fs::remove_all(dir);
 }
 

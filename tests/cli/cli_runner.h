@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -23,6 +24,23 @@ inline std::string read_text(const std::filesystem::path& path) {
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+// stderr without the progress lines of a run that took over a second ("render: 40%, 3 s left",
+// "render: rendering (sh), 1 s so far"): what a test of the messages reads.
+inline std::string without_progress(const std::string& err) {
+  std::string kept;
+  std::size_t pos = 0;
+  while (pos < err.size()) {
+    const std::size_t end = std::min(err.find('\n', pos), err.size());
+    const std::string line = err.substr(pos, end - pos);
+    const bool share = line.find("%, ") != std::string::npos && line.size() > 5 &&
+                       line.compare(line.size() - 5, 5, " left") == 0;
+    const bool alive = line.size() > 7 && line.compare(line.size() - 7, 7, " so far") == 0;
+    if (!share && !alive) kept += line + (end < err.size() ? "\n" : "");
+    pos = end + 1;
+  }
+  return kept;
 }
 
 /// A fresh, empty folder for one test.

@@ -526,6 +526,7 @@ void RadianceMapRenderer::Impl::render_blur() {
 }
 
 void RadianceMapRenderer::Impl::render_final() {
+  final_stale = false;
   const detail::Mat4f view_proj = detail::camera_view_proj(scene.camera, centre, radius_mm);
   final.begin_frame(view_proj, scene.backdrop);
   if (scene.ground) render_ground(view_proj);

@@ -23,12 +23,16 @@ class MapsLevelRunner final : public BudgetLevelRunner {
     settings_ = settings;
   }
   bool frame(MeasuredFrame& m) override {
+    const int light_maps = renderer_->stats().light_map_renders;
     if (!renderer_->render_frame()) return false;
+    // The light maps only where this frame drew them (point and directional lights: once a level,
+    // at its first frame; area lights: every frame).
+    const bool drew_light_maps = renderer_->stats().light_map_renders != light_maps;
     for (const auto& [name, ms] : renderer_->frame_stats().pass_ms) {
       if (name == "radiance map") {
         m.radiance_ms = ms;
       } else if (name == "light map") {
-        m.light_ms = ms;
+        m.light_ms = drew_light_maps ? ms : 0;
       } else {
         m.final_ms += ms;
       }
@@ -67,6 +71,7 @@ BudgetedMaps render_radiance_maps_within_budget(const Scene& scene,
   BudgetedMaps result;
   result.level = run.level;
   result.levels_run = run.levels_run;
+  result.levels_given_up = run.levels_given_up;
   result.level_seconds = run.level_seconds;
   result.requested_frame_ms = run.requested_frame_ms;
   result.image = runner.renderer().read_image();

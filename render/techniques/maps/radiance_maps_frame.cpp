@@ -13,6 +13,7 @@ void RadianceMapRenderer::set_camera(const Camera& camera) {
     impl_->final.resize(camera.width, camera.height);
   }
   impl_->scene.camera = camera;
+  impl_->final_stale = true;  // a split frame's partial calls draw the last sum from here
 }
 
 void RadianceMapRenderer::set_lights(const std::vector<Light>& lights) {
@@ -99,8 +100,11 @@ bool RadianceMapRenderer::render_frame() {
     m.last_call_units = count;
     m.next_unit += count;
     if (m.next_unit < total) {
+      // The frame goes on at the next call; the last finished sum (radiance[current], which this
+      // frame does not write) is shown, drawn anew when the camera moved or the image was resized.
+      if (m.final_stale && m.frame > 0) m.timed(kFinal, [&] { m.render_final(); });
       gl::check_errors("a part of a radiance-map frame");
-      return true;  // the frame goes on at the next call; the last final image stays
+      return true;
     }
     m.next_unit = 0;
     ++m.frame;

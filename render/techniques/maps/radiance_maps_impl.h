@@ -102,6 +102,7 @@ struct RadianceMapRenderer::Impl {
   // A frame split across render_frame calls (set_split): each layer in `bands` bands of rows,
   // `units_per_call` layer-bands a call (0: the whole frame), the next one to render.
   int bands = 1, units_per_call = 0, next_unit = 0, last_call_units = 0;
+  bool final_stale = false;  // the camera moved since the last final pass
   bool light_map_valid = false;
   bool programs_have_area_lights = false;  // compiled with LUCENT_AREA_LIGHTS
   std::vector<float> last_image;

@@ -45,9 +45,10 @@ struct MeasuredFrame {
 
 /// ms = a + b x fitted to measured (x, ms) pairs (one point per amount of work, 16 at most, each a
 /// running mean): least squares once two amounts of work 1.5x apart have been measured; before
-/// that, and where the fit comes out negative, the point with the largest ratio with half its time
-/// taken as fixed, which over-predicts a larger x where the fixed part is larger (the safe side of
-/// a budget; on llvmpipe the coarse level's fixed part is 50-80%).
+/// that, and where the fit comes out negative, from the point with the largest ratio: above it
+/// with half its time taken as fixed (which over-predicts a larger x where the fixed part is
+/// larger, the safe side of a budget; on llvmpipe the coarse level's is 50-80%), below it in
+/// proportion.
 class AffineCost {
  public:
   void record(double x, double ms);
@@ -103,6 +104,7 @@ class BudgetLevelRunner {
 struct ImageBudgetRun {
   int level = 0;                      ///< the last level done (the image's)
   std::vector<int> levels_run;        ///< in order, those given up included
+  std::vector<int> levels_given_up;   ///< the levels whose first measured frame said no
   std::vector<double> level_seconds;  ///< each one's set-up and frames, s
   double requested_frame_ms = 0;      ///< the cost model's prediction of a requested frame
 };

@@ -128,11 +128,12 @@ class RadianceMapRenderer final : public Technique {
   /// accumulated, then the final pass. Returns true if it accumulated a frame.
   bool render_frame() override;
   int accumulated_frames() const;
-  bool converged() const override;
+  bool converged() const override;  ///< T frames accumulated: further frames change nothing
   /// Splits each frame across calls of render_frame (the viewer's frame budget): every layer in
   /// `bands` bands of rows (1: whole layers), `units_per_call` layer-bands a call (0: the whole
-  /// frame at once, the default). A call that does not finish the frame renders no final image
-  /// (the last one stays); the frame's image is the same as unsplit. Changing `bands` restarts the
+  /// frame at once, the default). A call that does not finish the frame shows the last finished
+  /// frame (its final pass drawn again only when the camera moved); the frame's image is the same
+  /// as unsplit. Changing `bands` restarts the
   /// frame in progress.
   void set_split(int bands, int units_per_call);
   int last_call_units() const;     ///< layer-bands the last call rendered (0: none)
@@ -189,7 +190,8 @@ struct BudgetedMaps {
   ImageRgb image;                     ///< the last level rendered
   int level = 0;                      ///< its index in the ladder
   std::vector<double> level_seconds;  ///< wall clock of each level run, in order
-  std::vector<int> levels_run;        ///< their indices
+  std::vector<int> levels_run;        ///< their indices, those given up included
+  std::vector<int> levels_given_up;   ///< the levels whose first measured frame said no
   double requested_frame_ms = 0;      ///< the cost model's prediction for a requested frame
 };
 BudgetedMaps render_radiance_maps_within_budget(const Scene& scene,

@@ -61,10 +61,11 @@ struct ViewerOptions {
   ///   screenshot FILE.png | restart | quit
   std::string script;
   bool hide_panel = false;     ///< --hide-panel: start without the panel (H toggles it)
-  /// --frame-budget-ms: the maps' knobs not in `fixed` are chosen per frame from the quality
-  /// ladder (frame_budget.h) so that a frame takes about this long, and the image is rendered at
-  /// a reduced resolution while it refines when even the coarsest level's frame is over it;
-  /// 0: the knobs as given, whatever a frame costs.
+  /// --frame-budget-ms: the maps climb the quality ladder of the knobs not in `fixed`
+  /// (frame_budget.h) from the coarsest level to the requested settings, a level as the one below
+  /// converges, each frame split across display frames so that none takes much longer than this,
+  /// and the image rendered at a lower resolution while it refines when the final pass alone
+  /// takes over 40% of it; 0: the knobs as given, whole frames, whatever a frame costs.
   double frame_budget_ms = 50;
   FixedKnobs fixed;            ///< the maps' knobs given on the command line (and then the panel's)
   /// When the command started (the summary's "first image after S s").

@@ -4,7 +4,8 @@
 // object through its light map: a texel of the light map whose surface lies between the ground
 // point and the light occludes it (3 x 3 texels averaged, a soft edge of a texel). Area lights do
 // not light it. It fades out from 3 to 6 object radii and writes alpha 0: it is not the object
-// (masks, auto exposure and comparisons see the object alone).
+// (the mask leaves it out; auto exposure, which counts every lit pixel, sees it as it sees an
+// environment's background).
 in vec3 v_position;
 layout(location = 0) out vec4 out_color;
 
