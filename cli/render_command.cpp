@@ -120,6 +120,7 @@ render::ImageRgb render_maps_budgeted(RenderArguments& render_args, const render
   const auto start = std::chrono::steady_clock::now();
   budget.on_image = [&](const ImageRgb& image, int level) {
     write_outputs(render_args, image, scene, "radiance maps", written);
+    commit_pending_outputs();  // in place now, not when the run ends
     progress.finish();
     const double t =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
