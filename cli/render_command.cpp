@@ -280,7 +280,7 @@ void register_render_command(CLI::App& app) {
       "x/(1+x) per channel, sRGB) or EXR linear radiance (W mm^-2 sr^-1 per unit light). The mesh "
       "is centred and scaled so that its bounding-box diagonal is --object-size-mm.");
   args->scene.size = "256x256";
-  add_scene_options(cmd, args->scene, "image size WxH in pixels");
+  add_scene_options(cmd, args->scene, "image size WxH in pixels (N: N x N)");
   cmd->add_option("-o,--output", args->outputs,
                   "output image: .png (tone-mapped sRGB) or .exr (linear), or one of each "
                   "(-o a.png -o a.exr); written atomically")

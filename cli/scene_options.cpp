@@ -172,7 +172,12 @@ struct CameraArguments {
 };
 
 CameraArguments parse_camera(const SceneArguments& args) {
-  const auto size = parse_numbers(args.size, "--size", 2, 'x', "WxH in pixels, e.g. 256x256");
+  // One number is a square, as `simulate --size` takes it (--size 128 was refused here).
+  const bool square =
+      !args.size.empty() && args.size.find_first_not_of("0123456789") == std::string::npos;
+  const std::string text = square ? args.size + "x" + args.size : args.size;
+  const auto size =
+      parse_numbers(text, "--size", 2, 'x', "WxH in pixels, e.g. 256x256 (or 256 for a square)");
   if (size[0] < 1 || size[1] < 1 || size[0] > 16384 || size[1] > 16384 ||
       size[0] != std::floor(size[0]) || size[1] != std::floor(size[1])) {
     throw Error("--size: width and height must be whole numbers 1..16384, got '" + args.size + "'");

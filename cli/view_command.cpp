@@ -105,7 +105,7 @@ void register_view_command(CLI::App& app) {
   args->scene.options.reference.pixel_samples = 64;
   args->scene.options.pathtrace.pixel_samples = 4;
   args->scene.size = "960x720";
-  add_scene_options(cmd, args->scene, "window size WxH in pixels");
+  add_scene_options(cmd, args->scene, "window size WxH in pixels (N: N x N)");
   cmd->add_option("--deform", args->deform,
                   "sine deformer: amplitude as a fraction of the bounding-box diagonal (0 = off, "
                   "at most 0.2); the mesh moves every frame and the maps restart with it")

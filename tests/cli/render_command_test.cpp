@@ -198,7 +198,7 @@ INSTANTIATE_TEST_SUITE_P(
                 "--material marble --light directional:0,0,1:1,1,1 --snapshots 1", "--snapshots"},
         BadCase{"zero_size", "--material marble --light directional:0,0,1:1,1,1 --size 0x0",
                 "--size"},
-        BadCase{"bad_size", "--material marble --light directional:0,0,1:1,1,1 --size 64",
+        BadCase{"bad_size", "--material marble --light directional:0,0,1:1,1,1 --size 64x",
                 "--size"},
         BadCase{"env_not_an_image", "--material marble --env $DIR/notes.exr", "notes.exr"},
         BadCase{"bad_light", "--material marble --light directional:0,0,0:1,1,1", "--light"},
@@ -300,6 +300,22 @@ namespace {
 
 // --json: the summary as one JSON document on stdout (what a pipeline reads), the --stats
 // document inside it.
+// --size N is an N x N image (as simulate's --size), not a refusal.
+TEST(RenderCommand, OneSizeIsASquare) {
+  const auto dir = scratch_dir("render-square");
+  const auto r = run_lucent(
+      "render --technique reference --reference-samples-pixel 16 "
+      "--reference-threads 2 --material marble --mesh sphere --light "
+      "directional:1,1,1:2,2,2 --size 20 --json -o \"" +
+          (dir / "s.exr").string() + "\"",
+      "square");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto doc = nlohmann::json::parse(r.out);
+  EXPECT_EQ(doc.at("width"), 20);
+  EXPECT_EQ(doc.at("height"), 20);
+  fs::remove_all(dir);
+}
+
 TEST(RenderCommand, JsonSummaryOnStdout) {
   const auto dir = scratch_dir("render-json");
   const fs::path out = dir / "s.png";
