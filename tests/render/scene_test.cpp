@@ -116,14 +116,27 @@ TEST(MeshFiles, ObjWithInwardWindingGetsOutwardNormals) {
   write_text(path,
              "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
              "f 1 2 3\nf 1 4 2\nf 1 3 4\nf 2 4 3\n");
-  const Mesh mesh = load_mesh(path.string(), 10);
+  // Smooth normals (crease angle 180): each vertex's points away from the others.
+  const Mesh mesh = load_mesh(path.string(), 10, 180);
   EXPECT_EQ(mesh.triangles.size(), 4u);
   EXPECT_NEAR(diagonal(mesh), 10, 1e-4);
   expect_unit_outward_normals(mesh);
   const Vec3f c = mesh.centre();
-  // The vertex at the right angle of the tetrahedron points away from the others.
   for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
     EXPECT_GT(mesh.normals[i].dot(mesh.positions[i] - c), 0) << "vertex " << i;
+  }
+  // With the default crease angle (60 degrees; the faces meet at 55-125) every corner takes its
+  // face's normal, outward: away from the solid's centroid (the mean of the faces' centroids; the
+  // bounding box's centre lies outside this tetrahedron).
+  const Mesh flat = load_mesh(path.string(), 10);
+  expect_unit_outward_normals(flat);
+  Vec3f inside = Vec3f::Zero();
+  for (const auto& t : flat.triangles)
+    inside += (flat.positions[t[0]] + flat.positions[t[1]] + flat.positions[t[2]]) / 3;
+  inside /= float(flat.triangles.size());
+  for (const auto& t : flat.triangles) {
+    const Vec3f middle = (flat.positions[t[0]] + flat.positions[t[1]] + flat.positions[t[2]]) / 3;
+    for (unsigned v : t) EXPECT_GT(flat.normals[v].dot(middle - inside), 0);
   }
 }
 
