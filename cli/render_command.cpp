@@ -21,6 +21,7 @@
 #include "lucent/core/error.h"
 #include "lucent/core/json_file.h"
 #include "lucent/render/frame_budget.h"
+#include "lucent/render/fur_renderer.h"
 #include "lucent/render/render_settings.h"
 #include "lucent/render/scene.h"
 #include "lucent/render/technique.h"
@@ -39,6 +40,7 @@ struct RenderArguments {
   std::string output;                ///< the first of them (snapshots, messages)
   std::string budget = "60";         ///< --budget: seconds per image, or none
   render::FixedKnobs fixed;          ///< the maps' knobs given on the command line
+  bool reference_samples_given = false, pathtrace_samples_given = false;  ///< (their passes too)
   std::string stats;
   std::vector<int> snapshots;
   bool json = false;
@@ -107,6 +109,25 @@ Written write_outputs(const RenderArguments& render_args, const render::ImageRgb
   return {tone.exposure};
 }
 
+// The stats' "budget" of a maps run: the levels run, the quality reached, the requested one's cost.
+nlohmann::json maps_budget_doc(const render::BudgetedMapsOptions& budget,
+                               const render::BudgetedMaps& result) {
+  using render::quality_text;
+  const render::RenderSettings& used = budget.ladder[std::size_t(result.level)];
+  const render::RenderSettings& requested = budget.ladder.back();
+  return {{"budget_s",
+           std::isinf(budget.budget_s) ? nlohmann::json("none") : nlohmann::json(budget.budget_s)},
+          {"levels", budget.ladder.size()},
+          {"level", result.level},
+          {"levels_run", result.levels_run},
+          {"levels_given_up", result.levels_given_up},
+          {"level_seconds", result.level_seconds},
+          {"quality", quality_text(used)},
+          {"requested", quality_text(requested)},
+          {"requested_reached", result.level + 1 == int(budget.ladder.size())},
+          {"requested_predicted_s", requested.frames * result.requested_frame_ms / 1000}};
+}
+
 // The maps within --budget: the coarse image first, written at once, then the refined levels.
 render::ImageRgb render_maps_budgeted(RenderArguments& render_args, const render::Scene& scene,
                                       const render::TechniqueOptions& options,
@@ -134,19 +155,77 @@ render::ImageRgb render_maps_budgeted(RenderArguments& render_args, const render
   };
   const BudgetedMaps result =
       render_radiance_maps_within_budget(scene, options.maps, budget, &stats);
-  const RenderSettings& used = budget.ladder[std::size_t(result.level)];
-  const RenderSettings& requested = budget.ladder.back();
-  budget_doc = {{"budget_s", std::isinf(budget.budget_s) ? nlohmann::json("none")
-                                                         : nlohmann::json(budget.budget_s)},
-                {"levels", budget.ladder.size()},
-                {"level", result.level},
-                {"levels_run", result.levels_run},
-                {"levels_given_up", result.levels_given_up},
-                {"level_seconds", result.level_seconds},
-                {"quality", quality_text(used)},
-                {"requested", quality_text(requested)},
-                {"requested_reached", result.level + 1 == int(budget.ladder.size())},
-                {"requested_predicted_s", requested.frames * result.requested_frame_ms / 1000}};
+  budget_doc = maps_budget_doc(budget, result);
+  return result.image;
+}
+
+// Fur over a mesh within --budget: its skin is the maps', refined within what is left of the
+// budget (the shells' own pass is one draw); no coarse image (it would have no coat).
+render::ImageRgb render_fur_budgeted(RenderArguments& render_args, const render::Scene& scene,
+                                     const render::TechniqueOptions& options,
+                                     ProgressLine& progress, render::RenderStats& stats,
+                                     nlohmann::json& budget_doc) {
+  using namespace lucent::render;
+  const double budget_s = parse_budget(render_args.budget);
+  const auto start = std::chrono::steady_clock::now();
+  BudgetedMapsOptions budget;
+  budget.ladder = maps_quality_ladder(options.settings, render_args.fixed);
+  budget.progress = [&](double fraction, double) {
+    progress.update(std::uint64_t(std::lround(1000 * fraction)), 1000);
+  };
+  const SkinRenderer skin = [&](const Scene& skin_scene) {
+    const double spent =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    budget.budget_s = std::max(0.1 * budget_s, budget_s - spent);
+    const BudgetedMaps result =
+        render_radiance_maps_within_budget(skin_scene, options.maps, budget, nullptr);
+    budget_doc = maps_budget_doc(budget, result);
+    budget_doc["of"] = "the skin under the fur (the radiance maps)";
+    return result.image;
+  };
+  return render_fur(scene, options.fur, &stats, options.settings, skin);
+}
+
+// The reference or the path tracer within --budget: a coarse pass first, written at once, then
+// passes as many samples as fit (render_still_within_budget).
+render::ImageRgb render_cpu_budgeted(RenderArguments& render_args, render::TechniqueId id,
+                                     const render::Scene& scene,
+                                     const render::TechniqueOptions& options,
+                                     ProgressLine& progress, render::RenderStats& stats,
+                                     nlohmann::json& budget_doc,
+                                     std::vector<std::string>& written) {
+  using namespace lucent::render;
+  const double budget_s = parse_budget(render_args.budget);
+  const TechniqueInfo& technique = technique_info(id);
+  const bool area =
+      id == TechniqueId::kReference && options.reference.sampling == ReferenceSampling::kArea;
+  const std::string unit = area ? "surface samples" : "samples per pixel";
+  const auto start = std::chrono::steady_clock::now();
+  const auto on_image = [&](const ImageRgb& image, int pass, int samples) {
+    write_outputs(render_args, image, scene, technique.name, written);
+    commit_pending_outputs();  // in place now, not when the run ends
+    if (pass > 0) return;      // the last is reported with the run's summary
+    progress.finish();
+    const double t =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::fprintf(stderr, "render: a first coarse image in %s after %.1f s (%s)\n",
+                 render_args.output.c_str(), t, (std::to_string(samples) + " " + unit).c_str());
+    std::fflush(stderr);
+  };
+  const auto report = [&](double share) {
+    progress.update(std::uint64_t(std::lround(1000 * share)), 1000);
+  };
+  TechniqueOptions o = options;
+  o.reference.progress = o.pathtrace.progress = {};
+  const BudgetedStill result =
+      render_still_within_budget(id, scene, o, budget_s, on_image, report, &stats);
+  budget_doc = {{"budget_s", budget_s},
+                {"pass_samples", result.run.pass_samples},
+                {"pass_seconds", result.run.pass_seconds},
+                {"quality", std::to_string(result.run.samples) + " " + unit},
+                {"requested", std::to_string(result.requested) + " " + unit},
+                {"requested_reached", result.run.samples >= result.requested},
+                {"requested_predicted_s", result.run.requested_predicted_s}};
   return result.image;
 }
 
@@ -187,6 +266,13 @@ void run_render(RenderArguments& render_args) {
   RenderStats stats;
   nlohmann::json budget_doc;
   const bool budgeted = args.technique_id == TechniqueId::kMaps && render_args.snapshots.empty();
+  // The CPU techniques within a finite budget unless their samples (or passes) were given.
+  const bool cpu_budgeted =
+      std::isfinite(parse_budget(render_args.budget)) &&
+      ((args.technique_id == TechniqueId::kReference && !render_args.reference_samples_given) ||
+       (args.technique_id == TechniqueId::kPathtrace && !render_args.pathtrace_samples_given));
+  const bool fur_budgeted = args.technique_id == TechniqueId::kFur && scene.mesh.name != "tile" &&
+                            std::isfinite(parse_budget(render_args.budget));
   std::vector<std::string>
       written;  // the coarse and refined images: removed if a later stage fails
   ImageRgb image;
@@ -194,15 +280,19 @@ void run_render(RenderArguments& render_args) {
   // hierarchical links above all, has no share to report), on a terminal a ticker, elsewhere a
   // line after a second and every ten.
   std::unique_ptr<StageProgress> stages;
-  if (!budgeted && technique.gpu) {
+  if (!budgeted && !fur_budgeted && technique.gpu) {
     stages = std::make_unique<StageProgress>("render", false, true);
     stages->stage("rendering (" + technique.label + ")", 0);
   }
   Written out;
   try {
-    image = budgeted ? render_maps_budgeted(render_args, scene, options, progress, stats,
-                                            budget_doc, written)
-                     : render_still(args.technique_id, scene, options, &stats);
+    image = budgeted       ? render_maps_budgeted(render_args, scene, options, progress, stats,
+                                                  budget_doc, written)
+            : cpu_budgeted ? render_cpu_budgeted(render_args, args.technique_id, scene, options,
+                                                 progress, stats, budget_doc, written)
+            : fur_budgeted
+                ? render_fur_budgeted(render_args, scene, options, progress, stats, budget_doc)
+                : render_still(args.technique_id, scene, options, &stats);
     progress.finish();
     stages.reset();
     out = write_outputs(render_args, image, scene, technique.name, written);
@@ -287,10 +377,12 @@ void register_render_command(CLI::App& app) {
       ->required();
   cmd->add_option(
          "--budget", args->budget,
-         "maps: seconds per image (or none). A coarse first image is written at once, then "
-         "the highest quality whose time, predicted from the frames measured, fits the "
-         "budget (the requested K, W_s, W_l, N, T when they fit); knobs given explicitly "
-         "are kept at every level")
+         "seconds per image (or none). A coarse first image is written at once, then the "
+         "maps refine to the highest quality whose time, predicted from the frames measured, "
+         "fits (the requested K, W_s, W_l, N, T when they fit; knobs given explicitly are "
+         "kept at every level), the reference and the path tracer add passes of as many of "
+         "their samples as fit (all of them unless given: their samples or passes given, "
+         "they run whole); sh, hierarchical and fur run whole")
       ->capture_default_str();
   cmd->add_option("--snapshots", args->snapshots,
                   "maps: also write the linear image after these frames as OUT.f<t>.exr "
@@ -303,6 +395,8 @@ void register_render_command(CLI::App& app) {
                  "exposure, time and the --stats document) instead of the summary line");
   cmd->callback([cmd, args] {
     args->fixed = given_maps_knobs(cmd);  // explicit knobs win over the budget
+    args->reference_samples_given = given_reference_samples(cmd);
+    args->pathtrace_samples_given = given_pathtrace_samples(cmd);
     run_render(*args);
   });
 }

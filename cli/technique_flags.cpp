@@ -293,21 +293,33 @@ void warn_deprecated_flags(const CLI::App* cmd) {
   }
 }
 
+namespace {
+bool given(const CLI::App* cmd, std::initializer_list<const char*> names) {
+  for (const char* n : names) {
+    const CLI::Option* o = cmd->get_option_no_throw(n);
+    if (o != nullptr && o->count() > 0) return true;
+  }
+  return false;
+}
+}  // namespace
+
 render::FixedKnobs given_maps_knobs(const CLI::App* cmd) {
-  const auto given = [cmd](const std::string& name, const std::string& alias) {
-    for (const std::string& n : {name, alias}) {
-      const CLI::Option* o = cmd->get_option_no_throw(n);
-      if (o != nullptr && o->count() > 0) return true;
-    }
-    return false;
-  };
   render::FixedKnobs fixed;
-  fixed.frames = given("--maps-frames", "--frames");
-  fixed.directions = given("--maps-directions", "--directions");
-  fixed.samples = given("--maps-samples", "--samples");
-  fixed.radiance_map = given("--maps-radiance-map", "--radiance-map");
-  fixed.light_map = given("--maps-light-map", "--light-map");
+  fixed.frames = given(cmd, {"--maps-frames", "--frames"});
+  fixed.directions = given(cmd, {"--maps-directions", "--directions"});
+  fixed.samples = given(cmd, {"--maps-samples", "--samples"});
+  fixed.radiance_map = given(cmd, {"--maps-radiance-map", "--radiance-map"});
+  fixed.light_map = given(cmd, {"--maps-light-map", "--light-map"});
   return fixed;
+}
+
+bool given_reference_samples(const CLI::App* cmd) {
+  return given(cmd, {"--reference-samples-pixel", "--samples-pixel", "--reference-samples",
+                     "--samples-reference", "--reference-passes", "--passes"});
+}
+
+bool given_pathtrace_samples(const CLI::App* cmd) {
+  return given(cmd, {"--pathtrace-samples-pixel", "--pathtrace-passes"});
 }
 
 }  // namespace lucent::cli

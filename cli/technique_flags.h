@@ -22,6 +22,10 @@ void add_maps_sampling_flags(CLI::App* cmd, render::RenderSettings& settings);
 
 /// The maps' knobs given on `cmd`'s command line under either spelling (they win over a budget).
 render::FixedKnobs given_maps_knobs(const CLI::App* cmd);
+/// Whether the reference's samples (per pixel, on the surface) or passes were given; the path
+/// tracer's samples per pixel or passes.
+bool given_reference_samples(const CLI::App* cmd);
+bool given_pathtrace_samples(const CLI::App* cmd);
 
 /// One line on stderr naming the deprecated spellings `cmd` was given and their new names; nothing
 /// when none was used.

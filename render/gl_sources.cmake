@@ -83,6 +83,7 @@ target_sources(lucent_render PRIVATE
   "${LUCENT_GL_DIR}/gl/gl_program.cpp"
   "${LUCENT_GL_DIR}/techniques/maps/radiance_maps.cpp"
   "${LUCENT_GL_DIR}/techniques/maps/radiance_maps_frame.cpp"
+  "${LUCENT_GL_DIR}/techniques/maps/radiance_maps_passes.cpp"
   "${LUCENT_GL_DIR}/techniques/maps/radiance_maps_budget.cpp"
   "${LUCENT_GL_DIR}/techniques/maps/radiance_maps_sampling.cpp"
   "${LUCENT_GL_DIR}/techniques/sh/sh_renderer.cpp"

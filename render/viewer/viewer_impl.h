@@ -236,6 +236,8 @@ class Viewer {
   // The maps at another level of the ladder: the current one parked (programs compiled, textures
   // kept), the other one taken from the park or set up.
   void switch_maps_level(int level);
+  void level_prepared(const RadianceMapRenderer& maps);
+  void fit_to_budget();
   void apply_split();  // the frame split for the current level (plan_split)
   void set_parameter(const std::string& name, const std::string& value);
   void load_material(const std::string& source);
@@ -247,7 +249,7 @@ class Viewer {
   void screenshot(const std::filesystem::path& path);
   void blit(const ImageRgb& image, float exposure);  // tone-mapped, stretched to the window
   void draw_difference();  // the current technique against the cached reference
-  ImageRgb technique_image() const;  // the current technique's last image, window size
+  ImageRgb technique_image();  // the image shown: the current technique's (or the level below's)
   void draw_material_controls();     // colour and mean free path, or the coefficients
   void draw_coefficient_controls(materials::Material& m, bool& changed);
   void apply_material(const materials::Material& material);
@@ -332,8 +334,8 @@ class Viewer {
   std::vector<LiveTechnique> parked_maps_;  // by level: the maps set up at the other levels
   double layer_ms_ = 0, final_ms_ = 0;      // measured at the current level (running means)
   RenderSettings measured_at_;              // the level layer_ms_ was measured at
+  bool layer_ms_prior_ = false;             // layer_ms_ a level's prior (level_prepared)
   FrameSplit split_;                        // the maps' frame split now
-  bool level_first_frame_ = true;
   float render_scale_ = 1, refine_scale_ = 1;
   bool redraw_ = true;                    // something changed since the last rendered frame
   bool exposure_pending_frames_ = false;  // auto exposure waits for a few accumulated frames

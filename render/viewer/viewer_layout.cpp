@@ -69,10 +69,13 @@ void Viewer::apply_split() {
   const RenderSettings s = running_settings();
   // Before a frame of this level has been measured: the last level's measure in proportion to
   // the work, or, at the very start, a guess of a millisecond per 100,000 gathers (llvmpipe's
-  // order; a GPU is measured within a frame and the split relaxed).
-  double layer_ms = layer_ms_ > 0
-                        ? predict_layer_ms(layer_ms_, measured_at_, s)
-                        : 1e-5 * double(s.radiance_map_size) * s.radiance_map_size * s.samples;
+  // order; a GPU is measured within a frame and the split relaxed), and no less than a layer of
+  // the set-up's depth pre-pass (the same geometry, no gathering: the whole cost at small maps).
+  const double depth_layer_ms = maps->stats().depth_pass_ms / std::max(1, s.directions);
+  double layer_ms =
+      layer_ms_ > 0 ? predict_layer_ms(layer_ms_, measured_at_, s)
+                    : std::max(1e-5 * double(s.radiance_map_size) * s.radiance_map_size * s.samples,
+                               depth_layer_ms);
   split_ = plan_split(layer_ms, s.directions, final_ms_, frame_budget_ms_);
   maps->set_split(split_.bands, split_.units_per_call);
 }
@@ -107,7 +110,6 @@ void Viewer::budget_after_frame(Technique& t) {
   if (frame_budget_ms_ <= 0 || technique_ != TechniqueId::kMaps) return;
   auto* maps = dynamic_cast<RadianceMapRenderer*>(&t);
   if (maps == nullptr) return;
-  if (std::exchange(level_first_frame_, false)) return;  // it compiled the programs
   double radiance_ms = 0, final_ms = 0;
   for (const auto& [name, ms] : t.frame_stats().pass_ms) {
     if (name == "radiance map") radiance_ms = ms;
@@ -120,15 +122,43 @@ void Viewer::budget_after_frame(Technique& t) {
     const double layer = radiance_ms / units * double(split_.bands);
     const bool same_level =
         measured_at_.radiance_map_size == s.radiance_map_size && measured_at_.samples == s.samples;
-    layer_ms_ = layer_ms_ > 0 && same_level ? 0.7 * layer_ms_ + 0.3 * layer : layer;
+    layer_ms_ =
+        layer_ms_ > 0 && same_level && !layer_ms_prior_ ? 0.7 * layer_ms_ + 0.3 * layer : layer;
+    layer_ms_prior_ = false;
     measured_at_ = s;
   }
   if (!maps->frame_in_progress())
     final_ms_ = final_ms_ > 0 ? 0.7 * final_ms_ + 0.3 * final_ms : final_ms;
-  // (Not in the difference view: it holds the image against the reference pixel for pixel.)
+  fit_to_budget();
+}
+
+// A level set up (staged, a step a display frame): until its first call is measured, a layer
+// takes the larger of the last level's measure in proportion to the work (it misses the geometry's
+// fixed share: 2 layers of the second level took 134 ms where 40 were predicted) and the warm-up's
+// (an upper bound: a first draw compiles); the final pass, until measured once, the warm-up's.
+void Viewer::level_prepared(const RadianceMapRenderer& maps) {
+  const RadianceMapStats& w = maps.stats();
+  const RenderSettings s = running_settings();
+  const double predicted = layer_ms_ > 0 ? predict_layer_ms(layer_ms_, measured_at_, s) : 0;
+  layer_ms_ = std::max(predicted, w.warm_up_layer_ms);
+  measured_at_ = s;
+  layer_ms_prior_ = true;  // the first measure replaces it
+  if (final_ms_ <= 0) final_ms_ = w.warm_up_final_ms;
+  fit_to_budget();
+}
+
+// The final pass's resolution and the frame's split from the figures so far.
+void Viewer::fit_to_budget() {
+  // (Not in the difference view: it holds the image against the reference pixel for pixel.) Up
+  // again, a step at a time, while it takes under 15% (0.15 / 0.49 < 0.4: no see-saw).
   if (final_ms_ > 0.4 * frame_budget_ms_ && refine_scale_ > 0.3f && !show_difference_) {
     refine_scale_ *= 0.7f;
     final_ms_ *= 0.49;  // the pixels' share of it, roughly
+    set_render_scale(refine_scale_);
+  } else if (final_ms_ > 0 && final_ms_ < 0.15 * frame_budget_ms_ && refine_scale_ < 1 &&
+             !show_difference_) {
+    refine_scale_ = std::min(1.0f, refine_scale_ / 0.7f);
+    final_ms_ /= 0.49;
     set_render_scale(refine_scale_);
   }
   apply_split();

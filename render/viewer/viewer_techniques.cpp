@@ -22,6 +22,9 @@ TechniqueOptions Viewer::technique_options() const {
   TechniqueOptions o;
   o.settings = running_settings();  // the maps at the frame budget's level
   o.maps.time_stages = true;  // the panel shows the passes' times
+  // Within a frame budget a level is set up a step a display frame (a level's set-up took 0.2-0.3
+  // s on llvmpipe, input unanswered meanwhile); the level below is shown until it has a frame.
+  o.maps.staged_setup = frame_budget_ms_ > 0;
   o.sh = options_.sh;
   o.hierarchical = options_.hierarchical;
   o.fur = options_.fur;
@@ -85,7 +88,12 @@ void Viewer::draw_technique() {
     const bool converged = t->converged();
     const bool animated = deformer_ || (technique_ == TechniqueId::kFur && fur_lobe_);
     rendered_last_frame_ = !converged || redraw_ || animated;
-    if (rendered_last_frame_) {
+    auto* staged =
+        technique_ == TechniqueId::kMaps ? dynamic_cast<RadianceMapRenderer*>(t) : nullptr;
+    if (rendered_last_frame_ && staged != nullptr && !staged->prepared()) {
+      // This display frame's share of the level's set-up.
+      if (staged->prepare_step()) level_prepared(*staged);
+    } else if (rendered_last_frame_) {
       t->render_frame();
       ++frames_rendered_;
       redraw_ = false;
@@ -95,7 +103,6 @@ void Viewer::draw_technique() {
       if (technique_ == TechniqueId::kMaps && frame_budget_ms_ > 0 && t->converged() &&
           level_ + 1 < int(maps_quality_ladder(settings_, fixed_).size())) {
         switch_maps_level(level_ + 1);
-        apply_camera();
       }
       t = &current_technique();
     }
@@ -147,8 +154,12 @@ void Viewer::draw_technique() {
   }
 }
 
-ImageRgb Viewer::technique_image() const {
+ImageRgb Viewer::technique_image() {
   const Technique* t = live(technique_);
+  if (technique_ == TechniqueId::kMaps && t != nullptr && t->frame_stats().frames == 0) {
+    // A level still setting up, or before its first frame: the level below is what is shown.
+    if (const Technique* previous = previous_maps()) return previous->read_image();
+  }
   return t != nullptr ? t->read_image() : live(TechniqueId::kMaps)->read_image();
 }
 
@@ -211,7 +222,11 @@ void Viewer::draw_difference() {
     }
     const ImageDifference d = compare_images(small, ref, mask);
     if (info.physically_based) difference_text_ = d.to_string();
-    if (frames_drawn_ - difference_frame_ >= 30) {
+    // (Printed once the image has a frame: the maps set a level up over a few display frames.)
+    const bool has_image = !info.frame_snapshots || live(technique_)->frame_stats().frames > 0 ||
+                           (technique_ == TechniqueId::kMaps && previous_maps() != nullptr);
+    if (!has_image) difference_text_ = info.name + ": no frame yet";
+    if (has_image && frames_drawn_ - difference_frame_ >= 30) {
       const std::string frame =
           info.frame_snapshots
               ? " (frame " + std::to_string(live(technique_)->frame_stats().frames) + ")"

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <regex>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -109,6 +110,64 @@ TEST(RenderBudget, NoBudgetRefinesToTheExplicitSettingsImage) {
       kScene + fixed + "--maps-directions 16 -o \"" + explicit_.string() + "\"", "explicit");
   ASSERT_EQ(b.exit_code, 0) << b.err;
   EXPECT_LT(relative_rmse(refined, explicit_), 1e-6);
+  fs::remove_all(dir);
+}
+
+// The path tracer (and the reference: the same code) within a budget: a coarse pass of 1 of its
+// 64 samples written at once, then passes of as many as fit; its samples given, it runs them whole.
+TEST(RenderBudget, TheCpuTechniquesAddPassesWithinTheBudgetUnlessTheirSamplesAreGiven) {
+  const auto dir = scratch_dir("render-budget-cpu");
+  const fs::path png = dir / "p.png", stats = dir / "p.json";
+  const auto r = run_lucent(kScene + "--technique pathtrace --size 32x32 --budget 3 -o \"" +
+                                png.string() + "\" --stats \"" + stats.string() + "\"",
+                            "pathtrace-budget");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("render: a first coarse image in " + png.string()), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("(1 samples per pixel)"), std::string::npos) << r.err;
+  const auto budget = nlohmann::json::parse(std::ifstream(stats)).at("budget");
+  const auto passes = budget.at("pass_samples").get<std::vector<int>>();
+  ASSERT_FALSE(passes.empty());
+  EXPECT_EQ(passes.front(), 1);
+  int samples = 0;
+  for (int n : passes) samples += n;
+  EXPECT_LE(samples, 64);
+  EXPECT_EQ(budget.at("quality"), std::to_string(samples) + " samples per pixel");
+  EXPECT_EQ(budget.at("requested"), "64 samples per pixel");
+  EXPECT_EQ(budget.at("requested_reached").get<bool>(), samples == 64);
+  // The passes were sized to end within the budget (1.5x: a pass's time varies with the paths).
+  double seconds = 0;
+  for (const auto& s : budget.at("pass_seconds")) seconds += s.get<double>();
+  EXPECT_LT(seconds, 1.5 * 3) << budget.dump();
+
+  const auto given = run_lucent(kScene +
+                                    "--technique pathtrace --size 16x16 --budget 3 "
+                                    "--pathtrace-samples-pixel 2 -o \"" +
+                                    png.string() + "\" --json",
+                                "pathtrace-given");
+  ASSERT_EQ(given.exit_code, 0) << given.err;
+  EXPECT_FALSE(nlohmann::json::parse(given.out).contains("budget"));
+  EXPECT_EQ(given.err.find("first coarse image"), std::string::npos) << given.err;
+  fs::remove_all(dir);
+}
+
+// Fur over a mesh: the skin under the coat is the maps', within the budget (it took the seed's
+// maps settings whole: 17 min on llvmpipe at 640 x 480 where the budget's took 31 s).
+TEST(RenderBudget, FurOverAMeshRendersItsSkinWithinTheBudget) {
+  const auto dir = scratch_dir("render-budget-fur");
+  const fs::path png = dir / "f.png";
+  const auto r = run_lucent(kScene +
+                                "--technique fur --size 32x32 --maps-radiance-map 128 "
+                                "--maps-frames 4 --budget 4 --json -o \"" +
+                                png.string() + "\"",
+                            "fur-budget");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(png));
+  const auto budget = nlohmann::json::parse(r.out).at("budget");
+  EXPECT_EQ(budget.at("of"), "the skin under the fur (the radiance maps)");
+  EXPECT_EQ(budget.at("requested"), "K 16, W_s 128, W_l 512, N 50, T 4");
+  EXPECT_GE(budget.at("levels_run").size(), 1u) << budget.dump();
+  EXPECT_LE(budget.at("budget_s").get<double>(), 4);  // what was left of it for the skin
   fs::remove_all(dir);
 }
 

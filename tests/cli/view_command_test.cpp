@@ -155,7 +155,7 @@ TEST_F(ViewCommand, ShowsThePathTracerAndTheMapsAgainstIt) {
       "--material skin1 --light directional:1,0.2,0:3,3,3 --technique pathtrace "
       "--pathtrace-samples-pixel 2" +
       kTiny +
-      " --script 'settle; screenshot a.png; set technique maps; difference on; wait 31; "
+      " --script 'settle; screenshot a.png; set technique maps; difference on; settle; wait 31; "
       "quit'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ASSERT_TRUE(fs::exists(dir_ / "a.png")) << r.out << r.err;

@@ -277,5 +277,70 @@ TEST(FrameSplit, ALargerLevelIsPredictedInProportionToItsWork) {
   EXPECT_NEAR(predict_layer_ms(10, small, large), 10 * 16 * 25 / 9.0, 1e-9);
 }
 
+TEST(AffineCost, AFixedShareOfZeroPredictsInProportion) {
+  AffineCost cost(0.0);
+  cost.record(1, 400);
+  EXPECT_DOUBLE_EQ(cost.predict(30), 12000);
+}
+
+// The CPU techniques' samples: a machine whose pass of n samples takes fixed + per_sample n
+// seconds, on a fake clock.
+struct FakeSamplePasses {
+  double fixed_s, per_sample_s;
+  double clock_s = 0;
+  std::vector<int> ran;
+  SampleBudgetRun run(int requested, double budget_s) {
+    return run_sample_budget(
+        requested, budget_s, [this] { return clock_s; },
+        [this](int n, int pass) {
+          EXPECT_EQ(pass, int(ran.size()));
+          ran.push_back(n);
+          clock_s += fixed_s + per_sample_s * n;
+        });
+  }
+};
+
+TEST(SampleBudget, NoBudgetRunsEverySampleAfterACoarsePass) {
+  FakeSamplePasses machine{0.2, 0.05};
+  const SampleBudgetRun run = machine.run(1024, kInf);
+  EXPECT_EQ(run.pass_samples, (std::vector<int>{16, 1008}));  // requested / 64 first
+  EXPECT_EQ(run.samples, 1024);
+  EXPECT_EQ(machine.ran, run.pass_samples);
+  ASSERT_EQ(run.pass_seconds.size(), 2u);
+  EXPECT_NEAR(run.pass_seconds[0], 0.2 + 0.05 * 16, 1e-12);
+  FakeSamplePasses one{0.2, 0.05};
+  EXPECT_EQ(one.run(10, kInf).pass_samples, (std::vector<int>{1, 9}));  // at least one sample
+}
+
+TEST(SampleBudget, PassesFillTheBudgetWithoutGoingOver) {
+  // Little fixed time (the path tracer's) and much (a reference with a costly set-up): the passes
+  // end within the budget, and use most of it.
+  for (const double fixed_s : {0.0, 0.5, 3.0}) {
+    SCOPED_TRACE(testing::Message() << "fixed " << fixed_s << " s a pass");
+    FakeSamplePasses machine{fixed_s, 0.37};
+    const SampleBudgetRun run = machine.run(64, 8.0 + fixed_s);
+    EXPECT_LE(machine.clock_s, 8.0 + fixed_s);
+    EXPECT_GT(machine.clock_s, 0.6 * (8.0 + fixed_s));
+    EXPECT_LT(run.samples, 64);
+    int sum = 0;
+    for (int n : run.pass_samples) sum += n;
+    EXPECT_EQ(sum, run.samples);
+    // What all 64 would have taken, from the passes measured: the machine's own figure.
+    if (run.pass_samples.size() >= 2)
+      EXPECT_NEAR(run.requested_predicted_s, fixed_s + 0.37 * 64, 1e-6);
+  }
+}
+
+TEST(SampleBudget, TheNextPassIsTheMostThatFitsOrNone) {
+  AffineCost cost;
+  cost.record(10, 1000);                                   // 100 ms a sample ...
+  cost.record(40, 4000);                                   // ... and nothing fixed
+  EXPECT_EQ(next_pass_samples(100, 100, cost, kInf), 0);   // all done
+  EXPECT_EQ(next_pass_samples(100, 40, cost, kInf), 60);   // no budget: the rest
+  EXPECT_EQ(next_pass_samples(100, 40, cost, 10000), 60);  // 6 s fit in 90% of 10 s
+  EXPECT_EQ(next_pass_samples(100, 40, cost, 2000), 18);   // 1.8 s: 18 samples
+  EXPECT_EQ(next_pass_samples(100, 40, cost, 100), 0);     // not even one
+}
+
 }  // namespace
 }  // namespace lucent::render

@@ -1,6 +1,7 @@
-// Frames split across calls (RadianceMapRenderer::set_split, the viewer's frame budget): whole
-// layers or bands of rows a call give the image of the unsplit frame, and a partial call leaves
-// the last finished image on show.
+// Work split across calls for the viewer's frame budget: frames (RadianceMapRenderer::set_split),
+// whole layers or bands of rows a call, give the image of the unsplit frame, and a partial call
+// leaves the last finished image on show; a staged set-up (RadianceMapOptions::staged_setup, a
+// step a call) gives the image of the whole one.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -92,6 +93,62 @@ TEST_F(RadianceMapsSplitTest, APartialCallKeepsTheLastFinishedImage) {
   r.restart();
   EXPECT_FALSE(r.frame_in_progress());
   EXPECT_EQ(r.accumulated_frames(), 0);
+}
+
+TEST_F(RadianceMapsSplitTest, AStagedSetupGivesTheImageOfTheWholeOne) {
+  const Scene scene = sphere_scene();
+  RadianceMapRenderer whole;
+  whole.setup(scene, tiny());
+  const ImageRgb reference = converged_image(whole);
+  const float peak = *std::max_element(reference.data.begin(), reference.data.end());
+  ASSERT_GT(peak, 0.0f);
+
+  RadianceMapOptions staged;
+  staged.staged_setup = true;
+  RadianceMapRenderer r;
+  r.setup(scene, tiny(), staged);
+  EXPECT_FALSE(r.prepared());
+  const ImageRgb before = r.read_image();  // nothing rendered yet: black, the camera's size
+  ASSERT_EQ(before.width, 40);
+  ASSERT_EQ(before.height, 40);
+  EXPECT_EQ(*std::max_element(before.data.begin(), before.data.end()), 0.0f);
+  int calls = 1;
+  while (!r.prepare_step()) ++calls;
+  // Mesh and programs, light maps, radiance maps, final target and uniforms; the depth pre-pass
+  // in runs of ceil(6 / 4) = 2 layers (3 steps); the warm-up's light map, gather, blur and final.
+  EXPECT_EQ(calls, 10);
+  EXPECT_TRUE(r.prepared());
+  EXPECT_TRUE(r.prepare_step());  // done stays done
+  EXPECT_GT(r.stats().depth_pass_ms, 0.0);
+  EXPECT_GT(r.stats().warm_up_layer_ms, 0.0);
+  EXPECT_GT(r.stats().warm_up_final_ms, 0.0);
+  const ImageRgb image = converged_image(r);
+  ASSERT_EQ(image.data.size(), reference.data.size());
+  for (std::size_t i = 0; i < image.data.size(); ++i)
+    ASSERT_NEAR(image.data[i], reference.data[i], 1e-6f * peak) << "value " << i;
+}
+
+TEST_F(RadianceMapsSplitTest, AFrameFinishesAStagedSetupAndKeepsTheCameraGivenMeanwhile) {
+  Scene scene = sphere_scene();
+  RadianceMapOptions staged;
+  staged.staged_setup = true;
+  RadianceMapRenderer r;
+  r.setup(scene, tiny(), staged);
+  ASSERT_FALSE(r.prepare_step());  // the mesh and programs only
+  // Another view and size before the final target exists: it is built to them.
+  scene.camera = orbit_camera(scene.mesh, 70, -5, 3, 30, 20);
+  r.set_camera(scene.camera);
+  const ImageRgb image = converged_image(r);  // the first frame does the rest of the set-up
+  EXPECT_TRUE(r.prepared());
+  RadianceMapRenderer whole;
+  whole.setup(scene, tiny());
+  const ImageRgb reference = converged_image(whole);
+  ASSERT_EQ(image.width, 30);
+  ASSERT_EQ(image.height, 20);
+  const float peak = *std::max_element(reference.data.begin(), reference.data.end());
+  ASSERT_GT(peak, 0.0f);
+  for (std::size_t i = 0; i < image.data.size(); ++i)
+    ASSERT_NEAR(image.data[i], reference.data[i], 1e-6f * peak) << "value " << i;
 }
 
 }  // namespace

@@ -63,7 +63,8 @@ gl::Texture upload_image(const ImageRgb& image) {
 }  // namespace
 
 ImageRgb render_fur_mesh(const Scene& scene, const fur::FurOptions& options,
-                         const RenderSettings& skin_settings, RenderStats* stats) {
+                         const RenderSettings& skin_settings, RenderStats* stats,
+                         const SkinRenderer& skin_renderer) {
   const double t0 = now_ms();
   const Mesh& mesh = scene.mesh;
   if (mesh.triangles.empty()) throw Error("--technique fur: the mesh has no triangles");
@@ -79,7 +80,8 @@ ImageRgb render_fur_mesh(const Scene& scene, const fur::FurOptions& options,
 
   // The skin: the BSSRDF under the coat (its own headless context, closed on return).
   const double t_skin = now_ms();
-  const ImageRgb skin = render_radiance_maps(skin_scene, skin_settings);
+  const ImageRgb skin =
+      skin_renderer ? skin_renderer(skin_scene) : render_radiance_maps(skin_scene, skin_settings);
   const double skin_ms = now_ms() - t_skin;
 
   const auto context = GlContext::create_headless();

@@ -293,8 +293,8 @@ double FurRenderer::precompute_ms() const { return impl_->precompute_ms; }
 double FurRenderer::draw_ms() const { return impl_->draw_ms; }
 
 ImageRgb render_fur(const Scene& scene, const fur::FurOptions& options, RenderStats* stats,
-                    const RenderSettings& skin) {
-  if (scene.mesh.name != "tile") return render_fur_mesh(scene, options, skin, stats);
+                    const RenderSettings& skin, const SkinRenderer& skin_renderer) {
+  if (scene.mesh.name != "tile") return render_fur_mesh(scene, options, skin, stats, skin_renderer);
   const double t0 = now_ms();
   const auto context = GlContext::create_headless();
   FurRenderer renderer;

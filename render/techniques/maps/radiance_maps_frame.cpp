@@ -9,6 +9,10 @@
 namespace lucent::render {
 
 void RadianceMapRenderer::set_camera(const Camera& camera) {
+  if (impl_->stage <= Impl::kSetupFinalAndUniforms) {  // the final target is built from it later
+    impl_->scene.camera = camera;
+    return;
+  }
   if (camera.width != impl_->final.width() || camera.height != impl_->final.height()) {
     impl_->final.resize(camera.width, camera.height);
   }
@@ -20,6 +24,7 @@ void RadianceMapRenderer::set_lights(const std::vector<Light>& lights) {
   if (lights.empty() || int(lights.size()) > kMaxLights) {
     throw Error("--light: the radiance maps take 1 to " + std::to_string(kMaxLights) + " lights");
   }
+  impl_->finish_setup();
   const bool resize = int(lights.size()) != impl_->L;
   impl_->scene.lights = lights;
   impl_->L = int(lights.size());
@@ -38,6 +43,7 @@ void RadianceMapRenderer::set_lights(const std::vector<Light>& lights) {
 void RadianceMapRenderer::set_geometry(const std::vector<Vec3f>& positions,
                                        const std::vector<Vec3f>& normals) {
   Impl& m = *impl_;
+  m.finish_setup();
   gl::update_mesh(m.mesh, m.scene.mesh, positions, normals, "radiance maps");
   m.scene.mesh.positions = positions;
   m.scene.mesh.normals = normals;
@@ -47,11 +53,12 @@ void RadianceMapRenderer::set_geometry(const std::vector<Vec3f>& positions,
   m.radius_mm = m.scene.mesh.bounding_radius();
   m.upload_layers();
   m.upload_lights();
-  m.render_radiance_depth();
+  m.render_radiance_depth(0, m.K);
   restart();
 }
 
 void RadianceMapRenderer::set_material(const materials::Material& material) {
+  impl_->finish_setup();
   impl_->scene.material = material;
   impl_->upload_material();
   restart();
@@ -64,20 +71,23 @@ void RadianceMapRenderer::restart() {
   m.next_unit = 0;
   m.light_map_valid = false;
   m.last_image.clear();
-  const std::string renderer = m.stats.gl_renderer;
-  const double setup = m.stats.setup_ms;
-  const RadianceMapStats disc_stats = m.stats;
+  // What the set-up and the disc measured stays; the frames' figures start again.
+  const RadianceMapStats kept = m.stats;
   m.stats = RadianceMapStats{};
-  m.stats.gl_renderer = renderer;
-  m.stats.setup_ms = setup;
-  m.stats.sigma_star_per_mm = disc_stats.sigma_star_per_mm;
-  m.stats.disc_radius_mm = disc_stats.disc_radius_mm;
-  m.stats.used_disc_radius_mm = disc_stats.used_disc_radius_mm;
-  m.stats.samples_per_light = disc_stats.samples_per_light;
+  m.stats.gl_renderer = kept.gl_renderer;
+  m.stats.setup_ms = kept.setup_ms;
+  m.stats.depth_pass_ms = kept.depth_pass_ms;
+  m.stats.warm_up_layer_ms = kept.warm_up_layer_ms;
+  m.stats.warm_up_final_ms = kept.warm_up_final_ms;
+  m.stats.sigma_star_per_mm = kept.sigma_star_per_mm;
+  m.stats.disc_radius_mm = kept.disc_radius_mm;
+  m.stats.used_disc_radius_mm = kept.used_disc_radius_mm;
+  m.stats.samples_per_light = kept.samples_per_light;
 }
 
 bool RadianceMapRenderer::render_frame() {
   Impl& m = *impl_;
+  m.finish_setup();  // staged: what prepare_step() has not done yet
   const bool accumulate = m.frame < m.settings.frames;
   if (accumulate && m.next_unit == 0) {
     if (m.has_area_lights()) {
@@ -149,16 +159,20 @@ bool RadianceMapRenderer::converged() const {
 
 ImageRgb RadianceMapRenderer::read_image() const {
   const Impl& m = *impl_;
+  if (!prepared()) return ImageRgb(m.scene.camera.width, m.scene.camera.height);  // black
   return m.final.read_image();
 }
 
 std::vector<std::uint8_t> RadianceMapRenderer::read_mask() const {
   const Impl& m = *impl_;
+  if (!prepared())
+    return std::vector<std::uint8_t>(std::size_t(m.scene.camera.width) * m.scene.camera.height, 0);
   return m.final.read_mask();
 }
 
 void RadianceMapRenderer::present(float exposure, int x, int y, int width, int height) const {
   const Impl& m = *impl_;
+  if (!prepared()) return;  // nothing to show yet (the caller cleared the window)
   m.final.present(exposure, x, y, width, height);
 }
 

@@ -107,8 +107,23 @@ struct RadianceMapRenderer::Impl {
   bool programs_have_area_lights = false;  // compiled with LUCENT_AREA_LIGHTS
   std::vector<float> last_image;
   RadianceMapStats stats;
+  // The set-up's steps (setup_step): each under ~100 ms on llvmpipe at the viewer's levels.
+  enum SetupStage {
+    kSetupMeshAndPrograms,
+    kSetupLightMaps,
+    kSetupRadianceMaps,
+    kSetupFinalAndUniforms,
+    kSetupDepth,
+    kSetupWarmUp,
+    kSetupDone
+  };
+  SetupStage stage = kSetupMeshAndPrograms;
+  int depth_layers_done = 0, warm_up_done = 0;
 
+  /// Checks the inputs; the GL set-up follows in setup_step() calls (finish_setup: all of them).
   void build(const Scene& s, const RenderSettings& rs, const RadianceMapOptions& o);
+  bool setup_step();  ///< the next step of the set-up; true once it is done
+  void finish_setup();
   void upload_mesh();
   void build_programs();
   void build_light_maps();
@@ -123,7 +138,7 @@ struct RadianceMapRenderer::Impl {
   void upload_disc(int t, bool redraw);
   void upload_layers();
   void render_light_map();
-  void render_radiance_depth();
+  void render_radiance_depth(int first, int count);  ///< layers [first, first + count)
   /// Layer-bands [first, first + count) of frame t (t % 2 the buffer written; the first clears it).
   void render_radiance(int t, int first, int count);
   void render_blur();

@@ -46,17 +46,19 @@ struct MeasuredFrame {
 /// ms = a + b x fitted to measured (x, ms) pairs (one point per amount of work, 16 at most, each a
 /// running mean): least squares once two amounts of work 1.5x apart have been measured; before
 /// that, and where the fit comes out negative, from the point with the largest ratio: above it
-/// with half its time taken as fixed (which over-predicts a larger x where the fixed part is
-/// larger, the safe side of a budget; on llvmpipe the coarse level's is 50-80%), below it in
-/// proportion.
+/// with `fixed_share` of its time taken as fixed (which over-predicts a larger x where the fixed
+/// part is larger, the safe side of a budget; on llvmpipe the maps' coarse level's is 50-80%, the
+/// default 0.5), below it in proportion.
 class AffineCost {
  public:
+  explicit AffineCost(double fixed_share = 0.5) : fixed_share_(fixed_share) {}
   void record(double x, double ms);
   double predict(double x) const;
   bool empty() const { return samples_.empty(); }
 
  private:
   static constexpr std::size_t kKept = 16;
+  double fixed_share_;
   std::vector<std::pair<double, double>> samples_;
 };
 
@@ -137,5 +139,28 @@ double predict_layer_ms(double layer_ms, const RenderSettings& from, const Rende
 
 /// "K 16, W_s 512, W_l 512, N 50, T 100": a level in the flags' letters, for summaries.
 std::string quality_text(const RenderSettings& s);
+
+// The CPU techniques' budget (`lucent render --technique reference|pathtrace`): their samples in
+// passes whose images are averaged weighted by their samples, so that any split of the requested
+// samples gives the same expected image with the same noise as one pass of them all.
+
+/// The samples of the next pass: none when `done` >= `requested`; all that are left where
+/// `left_ms` is infinite or `cost` (ms against samples, fitted to the passes so far) predicts them
+/// to fit in 90% of it; else the most that are predicted to (none when not even one is).
+int next_pass_samples(int requested, int done, const AffineCost& cost, double left_ms);
+
+struct SampleBudgetRun {
+  std::vector<int> pass_samples;     ///< in order; their sum is the samples done
+  std::vector<double> pass_seconds;  ///< each pass's wall clock
+  int samples = 0;                   ///< done, of the requested
+  double requested_predicted_s = 0;  ///< what all the requested would have taken, predicted
+};
+
+/// A first coarse pass of requested / 64 samples (at least 1: an image early), then passes of
+/// next_pass_samples() until none is left or fits `budget_s` (infinity: all). `run_pass(samples,
+/// pass)` renders one; `now_s` is the clock (s), a fake one in tests.
+SampleBudgetRun run_sample_budget(int requested, double budget_s,
+                                  const std::function<double()>& now_s,
+                                  const std::function<void(int samples, int pass)>& run_pass);
 
 }  // namespace lucent::render

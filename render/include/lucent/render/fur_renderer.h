@@ -10,6 +10,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -82,9 +83,12 @@ class FurRenderer final : public Technique {
 /// One frame in a headless context (stats: technique "fur", precompute and draw times). On the
 /// tile, Klotzli & Olano; on any other mesh, the extension: `skin` (the radiance maps' settings)
 /// renders the BSSRDF under the coat (scene.fur_coat, or the tile's own coat_transmittance), then
-/// the shells are drawn over it (fur_mesh.cpp).
-ImageRgb render_fur(const Scene& scene, const fur::FurOptions& options, RenderStats* stats = nullptr,
-                    const RenderSettings& skin = {});
+/// the shells are drawn over it (fur_mesh.cpp). `skin_renderer`, when given, renders the skin
+/// instead (`lucent render --budget`: the maps within what is left of the budget).
+using SkinRenderer = std::function<ImageRgb(const Scene& skin_scene)>;
+ImageRgb render_fur(const Scene& scene, const fur::FurOptions& options,
+                    RenderStats* stats = nullptr, const RenderSettings& skin = {},
+                    const SkinRenderer& skin_renderer = {});
 
 /// Fur shells over a mesh (the extension of Klotzli & Olano): `render_fur` for meshes other than
 /// the tile. Shells at (s + 0.5) height_mm / shells along the vertex normals, the tile mapped by
@@ -93,6 +97,7 @@ ImageRgb render_fur(const Scene& scene, const fur::FurOptions& options, RenderSt
 /// the skin image, which the mesh's depth occludes. No mesh-scale shadows on the hairs (the skin
 /// has them: it comes from the maps).
 ImageRgb render_fur_mesh(const Scene& scene, const fur::FurOptions& options,
-                         const RenderSettings& skin, RenderStats* stats = nullptr);
+                         const RenderSettings& skin, RenderStats* stats = nullptr,
+                         const SkinRenderer& skin_renderer = {});
 
 }  // namespace lucent::render

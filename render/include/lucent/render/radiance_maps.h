@@ -55,6 +55,10 @@ struct RadianceMapOptions {
   bool time_stages = true;
   /// Add F_r(eta, n_o . w_o) L_env(reflect(-w_o, n_o)) where the scene has an environment map.
   bool environment_reflection = true;
+  /// setup() only checks its inputs; prepare_step() then does the GL set-up a step at a time
+  /// (under ~100 ms each on llvmpipe: the programs' first draws a step each), and the first
+  /// render_frame() whatever is left.
+  bool staged_setup = false;
   /// render_radiance_maps calls this with the image after each frame listed in `snapshot_frames`
   /// (`lucent render --snapshots`: convergence against frame count).
   std::function<void(int frame, const ImageRgb& image)> on_snapshot;
@@ -77,6 +81,10 @@ struct RadianceMapStats {
   int convergence_frame = 0;         ///< first frame changing the image by < tolerance; 0: not yet
   std::vector<double> frame_change;  ///< relative RMS change of the image at frames 2, 3, ...
   double setup_ms = 0;               ///< programs, textures, mesh upload (wall clock)
+  double depth_pass_ms = 0;          ///< of it, the depth pre-pass of the K layers
+  /// Of it, the untimed warm-up: one layer's gather (a band's time times the bands) and one final
+  /// pass; a first draw's compiling included, so upper bounds on what frames will take.
+  double warm_up_layer_ms = 0, warm_up_final_ms = 0;
   StageTimes last_wall;              ///< the last frame, glFinish + wall clock
   StageTimes sum_wall, sum_gpu;      ///< over accumulating frames (sum_gpu: GL_TIME_ELAPSED)
   int light_map_renders = 0;         ///< the light map is rendered on restart only
@@ -109,6 +117,10 @@ class RadianceMapRenderer final : public Technique {
   /// The same with options.settings and options.maps.
   void setup(const Scene& scene, const TechniqueOptions& options) override;
   TechniqueId id() const override { return TechniqueId::kMaps; }
+  /// With RadianceMapOptions::staged_setup: the next step of the set-up; true once it is done
+  /// (always true otherwise).
+  bool prepare_step();
+  bool prepared() const;
 
   /// The viewer's camera, of any size; the radiance maps do not depend on it, so accumulation
   /// goes on.

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "lucent/materials/profile_table.h"
+#include "lucent/render/frame_budget.h"
 #include "lucent/render/fur.h"
 #include "lucent/render/hierarchical.h"
 #include "lucent/render/path_tracer.h"
@@ -81,6 +82,22 @@ struct TechniqueOptions {
 /// row 0 at the top. Fills `stats` when given.
 ImageRgb render_still(TechniqueId id, const Scene& scene, const TechniqueOptions& options,
                       RenderStats* stats);
+
+/// The reference or the path tracer within `budget_s` seconds (infinity: all it was asked for):
+/// their samples (per pixel; the reference's area sampling: on the surface) times passes, split
+/// by run_sample_budget into passes of their own seeds, averaged weighted by their samples.
+/// `on_image(mean so far, pass, samples so far)` after every pass (the first: the coarse image);
+/// `progress(share)` the larger of the samples' and the budget's share. std::logic_error for
+/// another technique.
+struct BudgetedStill {
+  ImageRgb image;
+  SampleBudgetRun run;
+  int requested = 0;  ///< the samples asked for (per pass times passes)
+};
+BudgetedStill render_still_within_budget(
+    TechniqueId id, const Scene& scene, const TechniqueOptions& options, double budget_s,
+    const std::function<void(const ImageRgb& image, int pass, int samples)>& on_image,
+    const std::function<void(double share)>& progress, RenderStats* stats);
 
 /// The options technique `id` was run with, as text (the render statistics' "settings").
 std::string settings_text(TechniqueId id, const TechniqueOptions& options);
