@@ -382,7 +382,8 @@ void register_render_command(CLI::App& app) {
          "fits (the requested K, W_s, W_l, N, T when they fit; knobs given explicitly are "
          "kept at every level), the reference and the path tracer add passes of as many of "
          "their samples as fit (all of them unless given: their samples or passes given, "
-         "they run whole); sh, hierarchical and fur run whole")
+         "they run whole); fur over a mesh renders its skin (the maps) within what is left; sh "
+         "and hierarchical run whole")
       ->capture_default_str();
   cmd->add_option("--snapshots", args->snapshots,
                   "maps: also write the linear image after these frames as OUT.f<t>.exr "

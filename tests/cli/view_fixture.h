@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "cli_runner.h"
@@ -18,6 +19,10 @@
 namespace lucent::testing {
 
 namespace fs = std::filesystem;
+
+inline void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream(path) << text;
+}
 
 inline bool have_xvfb() {
   return std::system("command -v xvfb-run >/dev/null 2>&1") == 0;
@@ -90,13 +95,18 @@ class ViewCommand : public ::testing::Test {
   void TearDown() override {
     if (!dir_.empty()) fs::remove_all(dir_);
   }
-  // Runs `lucent view ARGS` in dir_ under a fresh virtual X server.
+  // Runs `lucent view ARGS` in dir_ under a fresh virtual X server; `input`, when given, runs in
+  // the same server beside the window (xdotool's mouse and keys: X events as a person's).
   CommandResult view(const std::string& args, const std::string& before = "",
-                     const std::string& screen = "640x480") {
+                     const std::string& screen = "640x480", const std::string& input = "") {
+    std::string session = "\"" LUCENT_BINARY "\" view " + args;
+    if (!input.empty()) {
+      write_text(dir_ / "session.sh", session + " &\nwindow=$!\n" + input + "\nwait $window\n");
+      session = "sh session.sh";
+    }
     const std::string command = "cd \"" + dir_.string() + "\" || exit 1; " + before +
                                 "MESA_SHADER_CACHE_DISABLE=true xvfb-run -a -n " + server_number() +
-                                " -s '-screen 0 " + screen + "x24' \"" LUCENT_BINARY "\" view " +
-                                args;
+                                " -s '-screen 0 " + screen + "x24' " + session;
     const fs::path out = dir_ / "stdout", err = dir_ / "stderr";
     const int status =
         std::system((command + " >\"" + out.string() + "\" 2>\"" + err.string() + "\"").c_str());

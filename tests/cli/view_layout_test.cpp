@@ -99,6 +99,33 @@ TEST_F(ViewCommand, RefinesLevelByLevelToTheRequestedImageAndThenIdles) {
   EXPECT_LE(differing_pixels(load_shot(refined), load_shot(dir_ / "a.png")), 5);
 }
 
+// A person's click (xdotool: an X event through the server, as a mouse's) on the panel's fold
+// arrow while the maps refine at the seed's settings (a frame was 17 s, and clicks between frames
+// were lost): the panel folds. The screenshots stay in the test's folder.
+TEST_F(ViewCommand, AClickWhileTheMapsRefineIsAnswered) {
+  if (std::system("command -v xdotool >/dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "xdotool not found (scripts/install-deps installs it)";
+  }
+  const std::string args =
+      "--material marble --mesh bunny --size 640x480 --script 'sleep 6; "
+      "screenshot-panel view_layout_clicked.png; quit'";
+  // The arrow at the title bar's left end, the window at the screen's corner (no window manager).
+  const CommandResult r = view(args, "", "640x480", "sleep 3\nxdotool mousemove 10 9 click 1");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Summary s = summary(r.out);
+  EXPECT_EQ(s.panel_state, "folded") << r.out;
+  EXPECT_LT(s.level, s.levels) << "the click came while the maps refined: " << r.out;
+  ASSERT_TRUE(fs::exists(dir_ / "view_layout_clicked.png"));
+  fs::copy_file(dir_ / "view_layout_clicked.png", "view_layout_clicked.png",
+                fs::copy_options::overwrite_existing);
+  std::printf("the window after the click: %s\n",
+              fs::absolute("view_layout_clicked.png").string().c_str());
+  // Without the click it stays open (the fold is the click's).
+  const CommandResult still = view(args, "", "640x480", "sleep 3");
+  ASSERT_EQ(still.exit_code, 0) << still.err;
+  EXPECT_EQ(summary(still.out).panel_state, "open") << still.out;
+}
+
 TEST_F(ViewCommand, SavesTheMaterialAsAMaterialFile) {
   const CommandResult r = view("--material ketchup --size 160x120" + kLevels +
                                " --maps-directions 4 --maps-samples 4 --script 'wait 2; key e; "
