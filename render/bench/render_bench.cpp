@@ -16,8 +16,7 @@ namespace lucent::render {
 int run_render_bench(const RenderBenchOptions& options, std::ostream& log) {
   std::ostringstream csv;
   csv << "mesh,triangles,K,W_s,W_l,N,M,disc,frames,size_px,light_map_ms,radiance_map_ms,mip_blur_"
-         "ms,"
-         "final_ms,frame_ms,setup_ms,device\n";
+         "ms,final_ms,frame_ms,setup_ms,memory_mib,seed_formula_mib,device\n";
   RenderSettings settings = options.settings;
   settings.frames = options.frames;
   settings.validate();
@@ -41,12 +40,15 @@ int run_render_bench(const RenderBenchOptions& options, std::ostream& log) {
         if (pass == "setup") setup = ms;
       }
       const std::string device = stats.details.value("gl_renderer", std::string("unknown"));
+      // The maps' GPU memory and Dal Corso's formula for it (Table 5.1; radiance_maps.h).
+      const nlohmann::json memory = stats.details.value("memory_mib", nlohmann::json::object());
       csv << name << ',' << scene.mesh.triangles.size() << ',' << settings.directions << ','
           << settings.radiance_map_size << ',' << settings.light_map_size << ',' << settings.samples
           << ',' << settings.disc_points << ',' << to_string(settings.disc_selection) << ','
           << settings.frames << ',' << options.size << ',' << stage[0] << ',' << stage[1] << ','
           << stage[2] << ',' << stage[3] << ',' << stage[0] + stage[1] + stage[2] + stage[3] << ','
-          << setup << ",\"" << device << "\"\n";
+          << setup << ',' << memory.value("total", 0.0) << ',' << memory.value("seed_formula", 0.0)
+          << ",\"" << device << "\"\n";
       log << "  " << name << " (" << scene.mesh.triangles.size() << " triangles, "
           << to_string(selection) << "): light map " << stage[0] << " ms, radiance map " << stage[1]
           << " ms, mip blur " << stage[2] << " ms, final " << stage[3] << " ms per frame on "

@@ -135,10 +135,13 @@ TEST(RenderBudget, TheCpuTechniquesAddPassesWithinTheBudgetUnlessTheirSamplesAre
   EXPECT_EQ(budget.at("quality"), std::to_string(samples) + " samples per pixel");
   EXPECT_EQ(budget.at("requested"), "64 samples per pixel");
   EXPECT_EQ(budget.at("requested_reached").get<bool>(), samples == 64);
-  // The passes were sized to end within the budget (1.5x: a pass's time varies with the paths).
-  double seconds = 0;
-  for (const auto& s : budget.at("pass_seconds")) seconds += s.get<double>();
-  EXPECT_LT(seconds, 1.5 * 3) << budget.dump();
+  // No pass began after the budget ran out (how close the last one ended to it is the planner's
+  // prediction, tested on a fake clock in frame_budget_test, not timed here).
+  const auto pass_seconds = budget.at("pass_seconds").get<std::vector<double>>();
+  ASSERT_EQ(pass_seconds.size(), passes.size());
+  double started = 0;
+  for (std::size_t i = 0; i + 1 < pass_seconds.size(); ++i) started += pass_seconds[i];
+  EXPECT_LT(started, 3) << budget.dump();
 
   const auto given = run_lucent(kScene +
                                     "--technique pathtrace --size 16x16 --budget 3 "

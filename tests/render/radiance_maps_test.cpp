@@ -35,6 +35,27 @@ namespace {
 
 // ---- CPU side: no OpenGL needed --------------------------------------------------------------
 
+// Dal Corso's Table 5.1: K 16, W_s 512, one light of 512, 193 MB (MiB: 64 a radiance map). Its
+// formula gives it; lucent's layout at the same settings (RGBA light maps, a half-float face
+// normal, three mip levels counted exactly) counted by hand.
+TEST(RadianceMapMemory, TheSeedsTableAndLucentsLayout) {
+  EXPECT_NEAR(seed_maps_memory_mib(16, 512, 1, 512), 193.67, 0.01);
+  RenderSettings s;
+  s.directions = 16;
+  s.radiance_map_size = 512;
+  s.light_map_size = 512;
+  const MapsMemory m = maps_memory(s, 1, 3);
+  EXPECT_DOUBLE_EQ(m.radiance_mib, 2 * 64 * (1 + 0.25 + 0.0625));  // two, each 64 with its mips
+  EXPECT_DOUBLE_EQ(m.radiance_depth_mib, 16);
+  EXPECT_DOUBLE_EQ(m.light_maps_mib, 11);  // 4 + 4 + 2 + 1
+  EXPECT_DOUBLE_EQ(m.total_mib(), 195);
+  EXPECT_DOUBLE_EQ(maps_memory(s, 3, 3).light_maps_mib, 33);
+  EXPECT_EQ(radiance_map_levels(s, 2), 3);
+  EXPECT_EQ(radiance_map_levels(s, 0), 1);
+  s.radiance_map_size = 2;
+  EXPECT_EQ(radiance_map_levels(s, 4), 2);  // no level below one texel
+}
+
 TEST(RadianceMapSampling, RadicalInverseIsVanDerCorput) {
   EXPECT_DOUBLE_EQ(detail::radical_inverse(1, 2), 0.5);
   EXPECT_DOUBLE_EQ(detail::radical_inverse(6, 2), 0.375);  // 110 -> 0.011
@@ -252,6 +273,9 @@ TEST_F(RadianceMapsTest, SphereIsFiniteNonNegativeAndBrighterOnTheLitSide) {
     const RadianceMapStats& stats = renderer.stats();
     EXPECT_EQ(stats.frames, settings.frames);
     EXPECT_LT(stats.uncovered_fraction, 0.02);  // K = 8 covers a sphere
+    // What it allocated: its K, W_s, its light, its blur's levels.
+    EXPECT_DOUBLE_EQ(stats.memory.total_mib(),
+                     maps_memory(settings, 1, radiance_map_levels(settings, -1)).total_mib());
     std::printf("%s: left %.4g right %.4g; %s\n", materials::to_string(model).c_str(), left, right,
                 stats.to_string().c_str());
   }

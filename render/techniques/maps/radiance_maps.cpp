@@ -68,6 +68,33 @@ std::string RadianceMapStats::to_string() const {
   return s.str();
 }
 
+int radiance_map_levels(const RenderSettings& settings, int max_blur_level) {
+  if (max_blur_level < 0) {
+    max_blur_level = settings.disc_distribution == DiscDistribution::kProfile ? 0 : 2;
+  }
+  int levels = 1;
+  while (levels <= max_blur_level && (settings.radiance_map_size >> levels) >= 1) ++levels;
+  return levels;
+}
+
+MapsMemory maps_memory(const RenderSettings& s, int lights, int mip_levels) {
+  constexpr double kMiB = 1024.0 * 1024.0;
+  const double layer = double(s.radiance_map_size) * s.radiance_map_size;
+  double mips = 0;  // texels of a layer's levels over its full size
+  for (int l = 0; l < mip_levels; ++l) mips += std::pow(0.25, l);
+  MapsMemory m;
+  m.radiance_mib = 2 * s.directions * layer * 16 * mips / kMiB;
+  m.radiance_depth_mib = s.directions * layer * 4 / kMiB;
+  m.light_maps_mib =
+      double(lights) * s.light_map_size * s.light_map_size * (16 + 16 + 8 + 4) / kMiB;
+  return m;
+}
+
+double seed_maps_memory_mib(int directions, int radiance_map_size, int lights, int light_map_size) {
+  const double ws2 = double(radiance_map_size) * radiance_map_size;
+  const double wl2 = double(light_map_size) * light_map_size;
+  return 4 * ((8.0 * 4.0 / 3.0 + 1) * directions * ws2 + 7.0 * lights * wl2) / (1024.0 * 1024.0);
+}
 
 RadianceMapRenderer::RadianceMapRenderer() : impl_(std::make_unique<Impl>()) {}
 RadianceMapRenderer::~RadianceMapRenderer() = default;
@@ -108,6 +135,8 @@ void RadianceMapRenderer::Impl::build(const Scene& s, const RenderSettings& rs,
   if (options.max_blur_level < 0) {
     options.max_blur_level = settings.disc_distribution == DiscDistribution::kProfile ? 0 : 2;
   }
+  stats.memory = maps_memory(settings, int(scene.lights.size()),
+                             radiance_map_levels(settings, options.max_blur_level));
   K = settings.directions;
   L = int(scene.lights.size());
   GLint max_block = 0;
@@ -293,8 +322,7 @@ void RadianceMapRenderer::Impl::build_light_maps() {
 
 void RadianceMapRenderer::Impl::build_radiance_maps() {
   const int W = settings.radiance_map_size;
-  levels = 1;
-  while (levels <= options.max_blur_level && (W >> levels) >= 1) ++levels;
+  levels = radiance_map_levels(settings, options.max_blur_level);
   radiance_depth = gl::create_texture(GL_TEXTURE_2D_ARRAY);
   glTextureStorage3D(radiance_depth.id(), 1, GL_DEPTH_COMPONENT32F, W, W, K);
   for (int b = 0; b < 2; ++b) {

@@ -28,7 +28,10 @@ void RadianceMapRenderer::set_lights(const std::vector<Light>& lights) {
   const bool resize = int(lights.size()) != impl_->L;
   impl_->scene.lights = lights;
   impl_->L = int(lights.size());
-  if (resize) impl_->build_light_maps();
+  if (resize) {
+    impl_->build_light_maps();
+    impl_->stats.memory = maps_memory(impl_->settings, impl_->L, impl_->levels);
+  }
   if (gl::has_area_lights(lights) != impl_->programs_have_area_lights) {
     // The programs' area-light branches come and go with the lights (gl_area_lights.h).
     impl_->build_programs();
@@ -75,6 +78,7 @@ void RadianceMapRenderer::restart() {
   const RadianceMapStats kept = m.stats;
   m.stats = RadianceMapStats{};
   m.stats.gl_renderer = kept.gl_renderer;
+  m.stats.memory = kept.memory;
   m.stats.setup_ms = kept.setup_ms;
   m.stats.depth_pass_ms = kept.depth_pass_ms;
   m.stats.warm_up_layer_ms = kept.warm_up_layer_ms;
@@ -247,6 +251,14 @@ void fill_render_stats(const RadianceMapRenderer& renderer, const Scene& scene,
       {"disc_radius_mm", s.disc_radius_mm},
       {"used_disc_radius_mm", s.used_disc_radius_mm},
       {"samples_per_light", s.samples_per_light},
+      // What the maps allocate, and Dal Corso's formula for the same K, W_s, L, W_l (Table 5.1).
+      {"memory_mib",
+       {{"radiance_maps", s.memory.radiance_mib},
+        {"radiance_depth", s.memory.radiance_depth_mib},
+        {"light_maps", s.memory.light_maps_mib},
+        {"total", s.memory.total_mib()},
+        {"seed_formula", seed_maps_memory_mib(settings.directions, settings.radiance_map_size,
+                                              int(scene.lights.size()), settings.light_map_size)}}},
       {"settings", settings.to_string()},
       {"options", options.to_string()}};
 }

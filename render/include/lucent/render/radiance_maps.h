@@ -69,6 +69,23 @@ struct RadianceMapOptions {
 };
 
 /// Per-stage times, ms.
+/// The GPU memory the radiance maps allocate, MiB (2^20 bytes): the two K-layer RGBA32F radiance
+/// arrays (ping-pong) with their mip levels, the shared K-layer 32-bit depth array, and the L light
+/// maps (positions and normals RGBA32F, face normals RGBA16F, 32-bit depth). The final target and
+/// the small buffers are left out, as Dal Corso's Table 5.1 leaves them.
+struct MapsMemory {
+  double radiance_mib = 0, radiance_depth_mib = 0, light_maps_mib = 0;
+  double total_mib() const { return radiance_mib + radiance_depth_mib + light_maps_mib; }
+};
+/// `mip_levels`: the radiance arrays' levels (1 + the blur levels, radiance_map_levels()).
+MapsMemory maps_memory(const RenderSettings& settings, int lights, int mip_levels);
+/// The radiance arrays' mip levels for a blur up to `max_blur_level` (-1: the options' default
+/// for the settings' disc, as the renderer resolves it).
+int radiance_map_levels(const RenderSettings& settings, int max_blur_level);
+/// Dal Corso's formula (seed 003, §5.3.8), MiB: 4 {[(4 + 4) 4/3 + 1] K W_s^2 + (3 + 3 + 1) L W_l^2}
+/// bytes (RGB light maps, mips as a third); 193 MiB at K 16, W_s = W_l = 512, one light.
+double seed_maps_memory_mib(int directions, int radiance_map_size, int lights, int light_map_size);
+
 struct StageTimes {
   double light_map_ms = 0, radiance_map_ms = 0, mip_blur_ms = 0, final_ms = 0;
   double total_ms() const { return light_map_ms + radiance_map_ms + mip_blur_ms + final_ms; }
@@ -80,6 +97,7 @@ struct RadianceMapStats {
   int frames_rendered = 0;           ///< render_frame() calls since the last restart
   int convergence_frame = 0;         ///< first frame changing the image by < tolerance; 0: not yet
   std::vector<double> frame_change;  ///< relative RMS change of the image at frames 2, 3, ...
+  MapsMemory memory;                 ///< what the renderer allocated (maps_memory)
   double setup_ms = 0;               ///< programs, textures, mesh upload (wall clock)
   double depth_pass_ms = 0;          ///< of it, the depth pre-pass of the K layers
   /// Of it, the untimed warm-up: one layer's gather (a band's time times the bands) and one final
