@@ -266,13 +266,14 @@ void run_render(RenderArguments& render_args) {
   RenderStats stats;
   nlohmann::json budget_doc;
   const bool budgeted = args.technique_id == TechniqueId::kMaps && render_args.snapshots.empty();
+  const bool finite_budget = std::isfinite(parse_budget(render_args.budget));
   // The CPU techniques within a finite budget unless their samples (or passes) were given.
   const bool cpu_budgeted =
-      std::isfinite(parse_budget(render_args.budget)) &&
+      finite_budget &&
       ((args.technique_id == TechniqueId::kReference && !render_args.reference_samples_given) ||
        (args.technique_id == TechniqueId::kPathtrace && !render_args.pathtrace_samples_given));
-  const bool fur_budgeted = args.technique_id == TechniqueId::kFur && scene.mesh.name != "tile" &&
-                            std::isfinite(parse_budget(render_args.budget));
+  const bool fur_budgeted =
+      args.technique_id == TechniqueId::kFur && scene.mesh.name != "tile" && finite_budget;
   std::vector<std::string>
       written;  // the coarse and refined images: removed if a later stage fails
   ImageRgb image;

@@ -69,13 +69,11 @@ void Viewer::apply_split() {
   const RenderSettings s = running_settings();
   // Before a frame of this level has been measured: the last level's measure in proportion to
   // the work, or, at the very start, a guess of a millisecond per 100,000 gathers (llvmpipe's
-  // order; a GPU is measured within a frame and the split relaxed), and no less than a layer of
-  // the set-up's depth pre-pass (the same geometry, no gathering: the whole cost at small maps).
-  const double depth_layer_ms = maps->stats().depth_pass_ms / std::max(1, s.directions);
-  double layer_ms =
-      layer_ms_ > 0 ? predict_layer_ms(layer_ms_, measured_at_, s)
-                    : std::max(1e-5 * double(s.radiance_map_size) * s.radiance_map_size * s.samples,
-                               depth_layer_ms);
+  // order; a GPU is measured within a frame and the split relaxed). A staged level replaces
+  // this with its warm-up's times once set up (level_prepared).
+  double layer_ms = layer_ms_ > 0
+                        ? predict_layer_ms(layer_ms_, measured_at_, s)
+                        : 1e-5 * double(s.radiance_map_size) * s.radiance_map_size * s.samples;
   split_ = plan_split(layer_ms, s.directions, final_ms_, frame_budget_ms_);
   maps->set_split(split_.bands, split_.units_per_call);
 }

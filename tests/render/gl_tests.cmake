@@ -7,6 +7,9 @@ lucent_add_test(glsl_twin_test
 lucent_add_test(radiance_maps_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/radiance_maps_test.cpp
   LIBS lucent::render lucent::materials OpenGL::OpenGL)
+lucent_add_test(radiance_maps_sampling_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/radiance_maps_sampling_test.cpp
+  LIBS lucent::render lucent::materials OpenGL::OpenGL)
 lucent_add_test(radiance_maps_split_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/radiance_maps_split_test.cpp
   LIBS lucent::render lucent::materials OpenGL::OpenGL)
@@ -43,7 +46,7 @@ lucent_add_test(oblique_skew_test
 # White-box: both include private headers of render/ (gl_program.h, gl_bssrdf.h,
 # radiance_maps_sampling.h).
 foreach(t glsl_twin_test geometry_factor_test oblique_skew_test radiance_maps_test
-          radiance_maps_split_test ground_test sh_renderer_test area_light_test fur_glsl_twin_test
+          radiance_maps_sampling_test radiance_maps_split_test ground_test sh_renderer_test area_light_test fur_glsl_twin_test
           fur_renderer_test)
   target_include_directories(${t} PRIVATE ${LUCENT_RENDER_PRIVATE_DIRS})
 endforeach()
