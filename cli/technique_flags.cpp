@@ -195,6 +195,9 @@ void add_hierarchical_flags(CLI::App* cmd, render::hierarchical::Options& o) {
          "-/+ z n_o)");
   flag(cmd, g, "--hierarchical-budget", "--hbe-budget", o.budget,
        "incremental mode: link factors evaluated per frame");
+  flag(cmd, g, "--hierarchical-threads", "", o.threads,
+       "threads for the oracle and the links' factors (0: all; the same links for any number)",
+       thread_count());
 }
 
 void add_fur_flags(CLI::App* cmd, render::fur::FurOptions& o) {

@@ -383,6 +383,17 @@ std::size_t crease_normals(Mesh& mesh, double crease_angle_deg) {
 
 Mesh load_mesh(const std::string& name_or_path, double object_size_mm, double crease_angle_deg) {
   check_object_size(object_size_mm);
+  if (const std::size_t at = name_or_path.rfind('@');
+      at != std::string::npos && at + 1 < name_or_path.size() && !fs::exists(name_or_path)) {
+    const std::string count = name_or_path.substr(at + 1);
+    if (count.size() > 9 || count.find_first_not_of("0123456789") != std::string::npos) {
+      throw Error("mesh '" + name_or_path +
+                  "': expected NAME@T with T a number of triangles, got '" + count + "' after '@'");
+    }
+    Mesh simple = simplify_mesh(load_mesh(name_or_path.substr(0, at), object_size_mm, 180),
+                                std::stoul(count), name_or_path);
+    return finish_mesh(std::move(simple), name_or_path, object_size_mm, false, crease_angle_deg);
+  }
   Mesh mesh;
   bool exact_normals = false;
   if (name_or_path == "sphere") {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 
@@ -120,6 +121,40 @@ TEST(MeshIo, AnObjCubeKeepsItsFaceNormals) {
   const Mesh smooth =
       finish_mesh(parse_obj(kCubeWithNormals, "cube.obj"), "cube.obj", 100.0, false, 180);
   EXPECT_GT(worst_flatness(smooth), 0.9999);
+}
+
+// NAME@T: simplified to about T triangles, still a closed surface of the asked size; bad counts
+// are one-line errors naming the mesh.
+TEST(MeshIo, SimplifiedMeshesKeepTheirSurface) {
+  const Mesh fine = load_mesh("sphere:4", 100);
+  const Mesh simple = load_mesh("sphere:4@1000", 100);
+  EXPECT_EQ(simple.name, "sphere:4@1000");
+  EXPECT_LE(simple.triangles.size(), 1000u);
+  EXPECT_GE(simple.triangles.size(), 900u);
+  EXPECT_EQ(simple.normals.size(), simple.positions.size());
+  // A closed mesh: every edge shared by exactly two triangles.
+  std::map<std::pair<unsigned, unsigned>, int> edges;
+  for (const auto& t : simple.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const unsigned a = t[std::size_t(k)], b = t[std::size_t((k + 1) % 3)];
+      ++edges[{std::min(a, b), std::max(a, b)}];
+    }
+  for (const auto& [edge, count] : edges) ASSERT_EQ(count, 2);
+  // Still a 100 mm sphere: every vertex within 2% of the radius of the fine one's.
+  const float radius = fine.positions[0].norm();
+  for (const Vec3f& p : simple.positions) EXPECT_NEAR(p.norm(), radius, 0.02 * radius);
+  for (const char* bad : {"sphere:4@abc", "sphere:2@5000", "sphere@2", "nothing@100"}) {
+    try {
+      load_mesh(bad, 100);
+      ADD_FAILURE() << bad << " loaded";
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("'" + std::string(bad).substr(0, std::string(bad).find('@'))),
+                std::string::npos)
+          << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  }
 }
 
 TEST(MeshIo, ACubeWithoutNormalsGetsHardEdgesAtTheCreaseAngle) {

@@ -3,6 +3,7 @@
 #include "lucent/render/hierarchical_form_factor.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -94,6 +95,52 @@ double integrate_segments(const EdgeIntegrand& g, double R, double t_lo, double 
   return 0.5 * L * (g(t0 - h) + g(t0 + h));
 }
 
+// Both sources of the chord placement share the pole, so the subdivision (which depends on the
+// edge, the pole and sigma only) and the angle: their integrands are summed in one pass.
+struct PairIntegrand {
+  EdgeIntegrand real, virt;
+};
+
+std::array<double, 2> integrate_pair(const PairIntegrand& g, double R, double t_lo, double t_hi,
+                                     int depth, const FormFactorOptions& o, long& segments) {
+  const double L = t_hi - t_lo, t0 = 0.5 * (t_lo + t_hi);
+  const double r0 = std::sqrt(R * R + t0 * t0);
+  const double sigma = g.real.sigma;
+  const bool fine =
+      L < o.edge_constant * r0 && (!o.global_condition || L * sigma < o.edge_constant);
+  if (!fine && depth < o.max_depth) {
+    const auto a = integrate_pair(g, R, t_lo, t0, depth + 1, o, segments);
+    const auto b = integrate_pair(g, R, t0, t_hi, depth + 1, o, segments);
+    return {a[0] + b[0], a[1] + b[1]};
+  }
+  segments += 2;  // one per source, as edge_term counts them
+  if (o.rule == SegmentRule::kSeedMidpoint) return {g.real(t0) * L, g.virt(t0) * L};
+  const double h = 0.5 * L / std::sqrt(3.0);
+  return {0.5 * L * (g.real(t0 - h) + g.real(t0 + h)), 0.5 * L * (g.virt(t0 - h) + g.virt(t0 + h))};
+}
+
+// edge_term for the two sources of one pole at once: Gamma_e of the real plus the virtual source.
+double edge_pair_term(const PlaneSource& real, const PlaneSource& virt, double sigma_tr,
+                      const Vec2d& a, const Vec2d& b, const FormFactorOptions& options,
+                      FormFactorCounters* counters) {
+  const Vec2d pa = a - real.pole, pb = b - real.pole;
+  const double L = (b - a).norm();
+  if (!(L > 0)) return 0;
+  const Vec2d u = (b - a) / L;
+  const double R = cross2(pa, u);
+  const double t1 = pa.dot(u), t2 = t1 + L;
+  if (std::abs(R) <= 1e-12 * (std::abs(t1) + std::abs(t2) + L)) return 0;  // as edge_term
+  const double dtheta = std::atan2(cross2(pa, pb), pa.dot(pb));
+  const double I1 = (real.z * std::exp(-sigma_tr * real.H) / real.H +
+                     virt.z * std::exp(-sigma_tr * virt.H) / virt.H) *
+                    dtheta;
+  long segments = 0;
+  const PairIntegrand g{{R * R, real.H * real.H, sigma_tr}, {R * R, virt.H * virt.H, sigma_tr}};
+  const auto I2 = integrate_pair(g, R, t1, t2, 0, options, segments);
+  if (counters) counters->segments += segments;
+  return I1 - R * (real.z * I2[0] + virt.z * I2[1]);
+}
+
 }  // namespace
 
 double edge_term(const PlaneSource& source, double sigma_tr, const Vec2d& a, const Vec2d& b,
@@ -126,6 +173,13 @@ double edges_form_factor(const materials::DiffusionCoefficients<double>& c, cons
   PlaneSource sources[2];
   dipole_sources(c, x_o, n_o, plane, options.placement, sources);
   double sum = 0;
+  if (sources[0].pole == sources[1].pole) {
+    for (std::size_t e = 0; e < edge_starts.size(); ++e) {
+      sum += edge_pair_term(sources[0], sources[1], c.sigma_tr, edge_starts[e], edge_ends[e],
+                            options, counters);
+    }
+    return c.alpha_prime / (4 * std::numbers::pi) * sum;
+  }
   for (const PlaneSource& s : sources) {
     for (std::size_t e = 0; e < edge_starts.size(); ++e) {
       sum += edge_term(s, c.sigma_tr, edge_starts[e], edge_ends[e], options, counters);

@@ -6,9 +6,11 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <mutex>
 #include <numbers>
 #include <optional>
 #include <sstream>
+#include <thread>
 #include <unordered_map>
 
 #include "area_light_irradiance.h"
@@ -21,62 +23,6 @@
 #include "reference_common.h"
 
 namespace lucent::render::hierarchical {
-
-Mode parse_mode(const std::string& text) {
-  if (text == "render") return Mode::kRender;
-  if (text == "incremental") return Mode::kIncremental;
-  if (text == "on-the-fly") return Mode::kOnTheFly;
-  throw Error("--hierarchical-mode: expected render, incremental or on-the-fly, got '" + text +
-              "'");
-}
-
-std::string to_string(Mode mode) {
-  return mode == Mode::kRender ? "render" : mode == Mode::kIncremental ? "incremental" : "on-the-fly";
-}
-
-void Options::validate() const {
-  auto positive = [](double v, const char* name) {
-    if (!(v > 0) || !std::isfinite(v)) {
-      throw Error(std::string(name) + ": expected a positive solid angle in sr, got " +
-                  std::to_string(v));
-    }
-  };
-  positive(epsilon_1, "--hierarchical-epsilon1");
-  positive(epsilon_2, "--hierarchical-epsilon2");
-  positive(near, "--hierarchical-near");
-  if (!(min_planarity >= 0 && min_planarity <= 1)) {
-    throw Error("--hierarchical-planarity: expected A'/A in [0, 1], got " +
-                std::to_string(min_planarity));
-  }
-  if (!(form_factor.edge_constant > 0 && form_factor.edge_constant <= 2)) {
-    throw Error("--hierarchical-edge-constant: expected a value in (0, 2] (the seed's 2/5), got " +
-                std::to_string(form_factor.edge_constant));
-  }
-  if (budget < 1) throw Error("--hierarchical-budget: expected at least 1 form factor per frame");
-}
-
-std::string Options::to_string() const {
-  std::ostringstream s;
-  s << "mode " << hierarchical::to_string(mode) << ", epsilon_1 " << epsilon_1 << " sr, epsilon_2 "
-    << epsilon_2 << " sr, near " << near << " sr, planarity " << min_planarity << ", edge c "
-    << form_factor.edge_constant << " (" << hierarchical::to_string(form_factor.rule) << ", dipole "
-    << hierarchical::to_string(form_factor.placement) << "), budget " << budget
-    << ", irradiance cache " << (irradiance_cache ? "on" : "off");
-  return s.str();
-}
-
-std::string Stats::to_string() const {
-  std::ostringstream s;
-  s << triangles << " triangles, " << clusters << " clusters (depth " << depth << "), " << links
-    << " links, " << form_factor_calls << " form factors (" << edge_segments << " edge segments), "
-    << point_samples << " point samples; ms: link " << link_ms << ", irradiance " << irradiance_ms
-    << ", pull " << pull_ms << ", gather " << gather_ms << ", push " << push_ms;
-  if (demoted || promoted || refreshed) {
-    s << "; incremental: " << demoted << " demoted, " << promoted << " promoted, " << refreshed
-      << " refreshed";
-  }
-  return s.str();
-}
 
 namespace {
 
@@ -93,10 +39,32 @@ double ms_since(Clock::time_point t) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
 }
 
+// A link's factor is kept in single precision (B is summed in double): 20 bytes a link, where
+// the dragon:3 makes 15 million.
 struct Link {
   int R = 0, E = 0;
-  Rgb F{};
+  std::array<float, 3> F{};
 };
+
+// What the factor evaluations of one thread counted, added into the frame's stats after.
+struct Tally {
+  long evaluations = 0, point_samples = 0;
+  FormFactorCounters form_factor;
+  void add(const Tally& t) {
+    evaluations += t.evaluations;
+    point_samples += t.point_samples;
+    form_factor.calls += t.form_factor.calls;
+    form_factor.segments += t.form_factor.segments;
+  }
+};
+
+// The oracle's work is handed to threads as subproblems (R, E): the pairs the oracle reaches from
+// (root, root) breadth first, until there are this many (a fixed number, so that the links and
+// their order, and so B to the last bit, do not depend on the number of threads).
+constexpr std::size_t kOracleTasks = 2048;
+// Subproblems linked at once in on-the-fly frames: their links are the only ones held in memory
+// at a time.
+constexpr std::size_t kTaskBatch = 512;
 
 enum class Decision { kSplitReceiver, kSplitEmitter, kLink };
 
@@ -112,13 +80,13 @@ struct Solver::Impl {
   std::unique_ptr<detail::IrradianceCache> cache;  // area lights, when o.irradiance_cache
   std::vector<Link> links;
   bool linked = false;
-  std::uint64_t material_version = 0, geometry_version = 0;
-  std::vector<std::uint64_t> link_material, link_geometry;  // versions each link was made at
+  std::uint32_t material_version = 0, geometry_version = 0;
+  int threads = 1;
+  std::vector<std::uint32_t> link_material, link_geometry;  // versions each link was made at
   std::size_t cursor = 0;
   std::vector<Rgb> E, B, face_B, vertex_B, face_E;
   Stats stats;
-  FormFactorCounters counters;
-  long evaluations = 0;  // factor() calls
+  Tally tally;  // the frame's factor evaluations
 
   void set_material(const materials::Material& m) {
     for (int ch = 0; ch < 3; ++ch) c[std::size_t(ch)] = materials::derive_coefficients(m.medium(ch));
@@ -152,8 +120,13 @@ struct Solver::Impl {
     return Decision::kLink;
   }
 
-  Rgb factor(int r, int e) {
-    Rgb F = planar_factor(r, e);
+  std::array<float, 3> factor(int r, int e, Tally& t) const {
+    const Rgb F = full_factor(r, e, t);
+    return {float(F[0]), float(F[1]), float(F[2])};
+  }
+
+  Rgb full_factor(int r, int e, Tally& t) const {
+    Rgb F = planar_factor(r, e, t);
     if (scene.geometry_factor) {  // the shape between the clusters (materials/geometry_factor.h)
       const Cluster& R = h[r];
       const Cluster& Em = h[e];
@@ -165,8 +138,8 @@ struct Solver::Impl {
     return F;
   }
 
-  Rgb planar_factor(int r, int e) {
-    ++evaluations;
+  Rgb planar_factor(int r, int e, Tally& t) const {
+    ++t.evaluations;
     const Cluster& R = h[r];
     const Cluster& Em = h[e];
     Rgb F{};
@@ -175,27 +148,30 @@ struct Solver::Impl {
         F[std::size_t(ch)] = point_form_factor(c[std::size_t(ch)], R.midpoint, R.normal,
                                                Em.midpoint, Em.area, o.form_factor.placement);
       }
-      ++stats.point_samples;
+      ++t.point_samples;
       return F;
     }
     const auto& P = h.welded_positions();
     const auto& edges = h.boundary();
     const PlaneFrame plane = PlaneFrame::from_normal(Em.midpoint, Em.normal);
-    std::vector<Vec2d> starts(std::size_t(Em.edge_count)), ends(std::size_t(Em.edge_count));
+    thread_local std::vector<Vec2d> starts, ends;
+    starts.resize(std::size_t(Em.edge_count));
+    ends.resize(std::size_t(Em.edge_count));
     for (int k = 0; k < Em.edge_count; ++k) {
       const auto& ed = edges[std::size_t(Em.first_edge + k)];
       starts[std::size_t(k)] = plane.project(P[std::size_t(ed[0])]);
       ends[std::size_t(k)] = plane.project(P[std::size_t(ed[1])]);
     }
     for (int ch = 0; ch < 3; ++ch) {
-      F[std::size_t(ch)] = edges_form_factor(c[std::size_t(ch)], R.midpoint, R.normal, plane, starts,
-                                             ends, o.form_factor, &counters);
+      F[std::size_t(ch)] = edges_form_factor(c[std::size_t(ch)], R.midpoint, R.normal, plane,
+                                             starts, ends, o.form_factor, &t.form_factor);
     }
     return F;
   }
 
-  // The oracle from (r, e) down; `emit` receives every link made.
-  void refine(int r, int e, const std::function<void(int, int)>& emit) const {
+  // The oracle from (r, e) down; `emit` receives every link made, depth first.
+  template <class Emit>
+  void refine(int r, int e, Emit& emit) const {
     switch (decide(r, e)) {
       case Decision::kSplitReceiver:
         for (int ch : h[r].child) refine(ch, e, emit);
@@ -208,32 +184,103 @@ struct Solver::Impl {
     }
   }
 
+  // The oracle's subproblems (kOracleTasks): each pass splits every pair the oracle splits into
+  // its two children, keeping linked pairs as they are, until there are enough or none splits.
+  std::vector<std::array<int, 2>> oracle_tasks() const {
+    std::vector<std::array<int, 2>> tasks{{h.root(), h.root()}}, next;
+    while (tasks.size() < kOracleTasks) {
+      next.clear();
+      bool split = false;
+      for (const auto& [r, e] : tasks) {
+        const Decision d = decide(r, e);
+        if (d == Decision::kLink) {
+          next.push_back({r, e});
+          continue;
+        }
+        split = true;
+        for (int ch : h[d == Decision::kSplitReceiver ? r : e].child) {
+          next.push_back(d == Decision::kSplitReceiver ? std::array<int, 2>{ch, e}
+                                                       : std::array<int, 2>{r, ch});
+        }
+      }
+      tasks.swap(next);
+      if (!split) break;
+    }
+    return tasks;
+  }
+
+  // The links of tasks [begin, end) with their factors, each task's in depth-first order, one
+  // task a work item; `out[k]` receives task begin + k's.
+  void make_links(const std::vector<std::array<int, 2>>& tasks, std::size_t begin, std::size_t end,
+                  std::vector<std::vector<Link>>& out) {
+    out.resize(end - begin);
+    std::mutex mutex;
+    detail::parallel_for(end - begin, threads, 1, [&](std::size_t b, std::size_t e) {
+      Tally local;
+      for (std::size_t k = b; k < e; ++k) {
+        std::vector<Link>& made = out[k];
+        made.clear();
+        auto emit = [&](int r, int em) { made.push_back({r, em, factor(r, em, local)}); };
+        refine(tasks[begin + k][0], tasks[begin + k][1], emit);
+      }
+      const std::lock_guard<std::mutex> lock(mutex);
+      tally.add(local);
+    });
+  }
+
+  // Every link from scratch, on `threads` threads: the same links in the same order whatever
+  // their number.
   void link_all() {
     links.clear();
-    refine(h.root(), h.root(), [&](int r, int e) { links.push_back({r, e, factor(r, e)}); });
+    const std::vector<std::array<int, 2>> tasks = oracle_tasks();
+    std::vector<std::vector<Link>> made;
+    make_links(tasks, 0, tasks.size(), made);
+    std::size_t total = 0;
+    for (const auto& m : made) total += m.size();
+    links.reserve(total);
+    for (auto& m : made) {
+      links.insert(links.end(), m.begin(), m.end());
+      std::vector<Link>().swap(m);
+    }
     link_material.assign(links.size(), material_version);
     link_geometry.assign(links.size(), geometry_version);
     linked = true;
     cursor = 0;
   }
 
+  // Factors for planned links, in parallel: `targets[k]` gets the factor of its own (R, E).
+  void evaluate(const std::vector<Link*>& targets) {
+    std::mutex mutex;
+    detail::parallel_for(targets.size(), threads, 64, [&](std::size_t b, std::size_t e) {
+      Tally local;
+      for (std::size_t k = b; k < e; ++k)
+        targets[k]->F = factor(targets[k]->R, targets[k]->E, local);
+      const std::lock_guard<std::mutex> lock(mutex);
+      tally.add(local);
+    });
+  }
+
   // kIncremental: up to o.budget links re-checked from the cursor on. A link the oracle now splits
   // is replaced by its children's links (one level); a stale one gets a new factor; then links
   // whose receiver's siblings all link the same emitter and whose parent the oracle accepts are
   // merged into the parent's link (one level up).
+  // The links to re-evaluate are chosen first (the oracle is cheap) and their factors evaluated
+  // after, in parallel.
   void repair() {
-    const long before = evaluations;
+    long planned = 0;  // factor evaluations
     std::vector<Link> added;
+    std::vector<std::size_t> refresh;
     std::vector<char> removed(links.size(), 0);
     std::size_t visited = 0;
-    while (visited < links.size() && evaluations - before < o.budget) {
+    while (visited < links.size() && planned < o.budget) {
       const std::size_t i = (cursor + visited) % links.size();
       ++visited;
       Link& l = links[i];
       if (link_material[i] == material_version && link_geometry[i] == geometry_version) continue;
       const Decision d = link_geometry[i] == geometry_version ? Decision::kLink : decide(l.R, l.E);
       if (d == Decision::kLink) {
-        l.F = factor(l.R, l.E);
+        refresh.push_back(i);
+        ++planned;
         link_material[i] = material_version;
         link_geometry[i] = geometry_version;
         ++stats.refreshed;
@@ -245,7 +292,8 @@ struct Solver::Impl {
       for (int ch : split.child) {
         const int r = d == Decision::kSplitReceiver ? ch : l.R;
         const int e = d == Decision::kSplitReceiver ? l.E : ch;
-        added.push_back({r, e, factor(r, e)});
+        added.push_back({r, e, {}});
+        ++planned;
       }
     }
     cursor = links.empty() ? 0 : (cursor + visited) % links.size();
@@ -271,12 +319,17 @@ struct Solver::Impl {
         const int r = side == 0 ? p : other, e = side == 0 ? other : p;
         if (decide(r, e) != Decision::kLink) continue;
         removed[std::size_t(pair[0])] = removed[std::size_t(pair[1])] = 1;
-        added.push_back({r, e, factor(r, e)});
+        added.push_back({r, e, {}});
         ++stats.promoted;
       }
     }
+    std::vector<Link*> targets;
+    targets.reserve(refresh.size() + added.size());
+    for (std::size_t i : refresh) targets.push_back(&links[i]);
+    for (Link& l : added) targets.push_back(&l);
+    evaluate(targets);
     std::vector<Link> kept;
-    std::vector<std::uint64_t> km, kg;
+    std::vector<std::uint32_t> km, kg;
     kept.reserve(links.size() + added.size());
     for (std::size_t i = 0; i < links.size(); ++i) {
       if (removed[i]) continue;
@@ -292,6 +345,17 @@ struct Solver::Impl {
     links = std::move(kept);
     link_material = std::move(km);
     link_geometry = std::move(kg);
+  }
+
+  double memory_mib() const {
+    const double hierarchy = double(h.clusters().size() * sizeof(Cluster) +
+                                    h.boundary().size() * sizeof(h.boundary()[0]) +
+                                    h.welded_positions().size() * sizeof(Eigen::Vector3d) +
+                                    (h.faces().size() + h.weld().size()) * sizeof(int));
+    const double stored =
+        double(links.capacity() * sizeof(Link) +
+               (link_material.capacity() + link_geometry.capacity()) * sizeof(std::uint32_t));
+    return (hierarchy + stored) / (1024.0 * 1024.0);
   }
 
   void irradiance() {
@@ -364,7 +428,7 @@ struct Solver::Impl {
   void frame() {
     stats.form_factor_calls = stats.point_samples = stats.edge_segments = 0;
     stats.demoted = stats.promoted = stats.refreshed = 0;
-    counters = {};
+    tally = {};
     auto t0 = Clock::now();
     if (o.mode != Mode::kOnTheFly) {
       if (!linked || o.mode == Mode::kRender) {
@@ -379,6 +443,7 @@ struct Solver::Impl {
       geometry_version_seen = geometry_version;
     }
     stats.link_ms = ms_since(t0);
+    stats.memory_mib = memory_mib();
 
     t0 = Clock::now();
     irradiance();
@@ -404,25 +469,33 @@ struct Solver::Impl {
     stats.pull_ms = ms_since(t0);
 
     t0 = Clock::now();
-    auto gather = [&](int r, int e, const Rgb& F) {
+    auto gather = [&](int r, int e, const std::array<float, 3>& F) {
       for (int ch = 0; ch < 3; ++ch) {
         B[std::size_t(r)][std::size_t(ch)] += F[std::size_t(ch)] * E[std::size_t(e)][std::size_t(ch)];
       }
     };
     if (o.mode == Mode::kOnTheFly) {
+      // No links kept: a batch of the oracle's subproblems at a time, linked in parallel and
+      // gathered in order (the same sums as the render mode's).
       long made = 0;
-      refine(h.root(), h.root(), [&](int r, int e) {
-        ++made;
-        gather(r, e, factor(r, e));
-      });
+      const std::vector<std::array<int, 2>> tasks = oracle_tasks();
+      std::vector<std::vector<Link>> batch;
+      for (std::size_t begin = 0; begin < tasks.size(); begin += kTaskBatch) {
+        make_links(tasks, begin, std::min(tasks.size(), begin + kTaskBatch), batch);
+        for (const auto& links_made : batch) {
+          for (const Link& l : links_made) gather(l.R, l.E, l.F);
+          made += long(links_made.size());
+        }
+      }
       stats.links = made;
     } else {
       for (const Link& l : links) gather(l.R, l.E, l.F);
       stats.links = long(links.size());
     }
     stats.gather_ms = ms_since(t0);
-    stats.form_factor_calls = counters.calls;
-    stats.edge_segments = counters.segments;
+    stats.form_factor_calls = tally.form_factor.calls;
+    stats.edge_segments = tally.form_factor.segments;
+    stats.point_samples = tally.point_samples;
 
     t0 = Clock::now();
     // Push: parents before children (decreasing ids), each child adds its parent's B.
@@ -472,6 +545,8 @@ Solver::Solver(const Scene& scene, const Options& options) : impl_(std::make_uni
   m.stats.clusters = int(m.h.clusters().size());
   m.stats.depth = m.h.depth();
   m.rays = std::make_unique<detail::RayScene>(scene.mesh);
+  m.threads = options.threads > 0 ? options.threads
+                                  : int(std::max(1u, std::thread::hardware_concurrency()));
   m.set_material(scene.material);
 }
 
@@ -508,39 +583,5 @@ const std::vector<std::array<double, 3>>& Solver::vertex_B() const { return impl
 const std::vector<std::array<double, 3>>& Solver::face_E() const { return impl_->face_E; }
 const Hierarchy& Solver::hierarchy() const { return impl_->h; }
 const Stats& Solver::stats() const { return impl_->stats; }
-
-std::vector<std::array<double, 3>> all_pairs_B(const Mesh& mesh, const materials::Material& material,
-                                               const std::vector<std::array<double, 3>>& face_E,
-                                               const FormFactorOptions& options) {
-  std::array<Coefficients, 3> c{};
-  for (int ch = 0; ch < 3; ++ch) c[std::size_t(ch)] = materials::derive_coefficients(material.medium(ch));
-  const std::size_t T = mesh.triangles.size();
-  std::vector<Eigen::Vector3d> mid(T), normal(T);
-  for (std::size_t t = 0; t < T; ++t) {
-    const auto& tri = mesh.triangles[t];
-    const Eigen::Vector3d a = mesh.positions[tri[0]].cast<double>(),
-                          b = mesh.positions[tri[1]].cast<double>(),
-                          d = mesh.positions[tri[2]].cast<double>();
-    mid[t] = (a + b + d) / 3;
-    const Eigen::Vector3d n = (b - a).cross(d - a);
-    normal[t] = n.norm() > 0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::UnitZ();
-  }
-  std::vector<std::array<double, 3>> B(T, Rgb{});
-  for (std::size_t r = 0; r < T; ++r) {
-    for (std::size_t e = 0; e < T; ++e) {
-      const auto& tri = mesh.triangles[e];
-      for (int ch = 0; ch < 3; ++ch) {
-        if (face_E[e][std::size_t(ch)] == 0) continue;
-        B[r][std::size_t(ch)] +=
-            face_E[e][std::size_t(ch)] *
-            triangle_form_factor(c[std::size_t(ch)], mid[r], normal[r],
-                                 mesh.positions[tri[0]].cast<double>(),
-                                 mesh.positions[tri[1]].cast<double>(),
-                                 mesh.positions[tri[2]].cast<double>(), options);
-      }
-    }
-  }
-  return B;
-}
 
 }  // namespace lucent::render::hierarchical

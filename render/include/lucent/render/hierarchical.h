@@ -66,6 +66,9 @@ struct Options {
   /// per light set and geometry, looked up every frame; render/core/irradiance_cache.h), texel
   /// the bounding radius / 64; false: 16 shadow rays per leaf every frame.
   bool irradiance_cache = true;
+  /// Threads for the oracle and the links' factors (0: every core). The links, their order and B
+  /// are the same for any number.
+  int threads = 0;
 
   void validate() const;  ///< throws lucent::Error naming the option
   std::string to_string() const;
@@ -77,6 +80,9 @@ struct Stats {
   long form_factor_calls = 0, point_samples = 0, edge_segments = 0;  ///< in the last frame
   long demoted = 0, promoted = 0, refreshed = 0;                      ///< kIncremental, last frame
   double build_ms = 0;  ///< the hierarchy
+  /// What the solve holds, MiB: the hierarchy (clusters, boundary edges, welded vertices) and the
+  /// stored links with their versions (none in kOnTheFly, whose links live one batch at a time).
+  double memory_mib = 0;
   double link_ms = 0, irradiance_ms = 0, pull_ms = 0, gather_ms = 0, push_ms = 0;  ///< last frame
   double total_ms() const { return link_ms + irradiance_ms + pull_ms + gather_ms + push_ms; }
   std::string to_string() const;

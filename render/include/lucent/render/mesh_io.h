@@ -28,6 +28,12 @@ Mesh parse_obj(std::string_view text, const std::string& source);
 /// sub-millimetre precision scattering needs).
 inline constexpr double kMaxObjectSizeMm = 1e6;
 
+/// `mesh` simplified to at most `target_triangles` (meshoptimizer's quadric edge collapses, corners
+/// at one position welded first; positions and triangles only: finish_mesh gives the normals). What
+/// load_mesh does for "NAME@T". Throws lucent::Error naming `name` unless 4 <= T < the mesh's
+/// count.
+Mesh simplify_mesh(const Mesh& mesh, std::size_t target_triangles, const std::string& name);
+
 /// Throws lucent::Error naming --object-size-mm unless 0 < size <= kMaxObjectSizeMm.
 void check_object_size(double object_size_mm);
 

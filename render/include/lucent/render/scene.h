@@ -119,7 +119,9 @@ Light parse_light(const std::string& text);
 /// centred and scaled so that its bounding-box diagonal is `object_size_mm`. A file's normals (OBJ
 /// `vn`, PLY nx ny nz) are used; a file without them gets hard edges where faces meet at more
 /// than `crease_angle_deg` (kDefaultCreaseAngleDeg; 180: smooth everywhere), the built-in scans
-/// smooth normals. Empty meshes throw; non-manifold ones load with a warning on stderr.
+/// smooth normals. Empty meshes throw; non-manifold ones load with a warning on stderr. "NAME@T"
+/// (any of these, T a whole number) is that mesh simplified to about T triangles (simplify_mesh),
+/// e.g. "bunny@2016", the seed 004's sizes; a file whose name has an '@' is read as a file.
 inline constexpr double kDefaultCreaseAngleDeg = 60;
 Mesh load_mesh(const std::string& name_or_path, double object_size_mm = 100.0,
                double crease_angle_deg = kDefaultCreaseAngleDeg);
