@@ -110,6 +110,46 @@ void register_fur_bench(CLI::App* bench) {
   });
 }
 
+// `lucent bench hierarchical`: seed 004's modes, links and memory beside its Table 3.
+void register_hierarchical_bench(CLI::App* bench) {
+  auto o = std::make_shared<render::HierarchicalBenchOptions>();
+  CLI::App* cmd = bench->add_subcommand(
+      "hierarchical",
+      "Seed 004's modes on the CPU (Mertens et al.): linking, render-mode frames (a light "
+      "turning), "
+      "on-the-fly and incremental frames of a deforming mesh, links and their memory, for lucent's "
+      "defaults and the seed's Table 3 setting, beside the paper's figures; and links per triangle "
+      "against the error from the all-pairs solution -> hierarchical.csv, hierarchical_error.csv, "
+      "hierarchical.png");
+  cmd->add_option("--out-dir", o->out_dir, "folder for the CSVs and the figure")
+      ->capture_default_str();
+  cmd->add_option("--meshes", o->meshes, "meshes to time (NAME@T: simplified to T triangles)")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--threads", o->threads, "thread counts to time (0: every core)")
+      ->delimiter(',')
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
+  cmd->add_option("--frames", o->frames, "frames timed per mode (median reported)")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  cmd->add_option("--incremental-budget", o->incremental_budget,
+                  "incremental frames: factor evaluations per frame")
+      ->check(CLI::Range(1L, 1000000000L))
+      ->capture_default_str();
+  cmd->add_option("--error-mesh", o->error_mesh, "mesh of the links-against-error sweep")
+      ->capture_default_str();
+  cmd->add_option("--material", o->material, "bundled material or file")->capture_default_str();
+  cmd->callback([o] {
+    check_output_folder(o->out_dir / "hierarchical.csv");
+    const auto result = render::run_hierarchical_bench(*o, std::cout);
+    std::cout << "bench hierarchical: " << result.rows << " rows, " << result.error_rows
+              << " error rows; wrote hierarchical.csv, hierarchical_error.csv and "
+                 "hierarchical.png in "
+              << o->out_dir.string() << '\n';
+  });
+}
+
 // `lucent bench tradeoff`: every technique's knobs swept against a converged CPU reference.
 void register_tradeoff_bench(CLI::App* bench) {
   auto tradeoff = std::make_shared<render::TradeoffBenchOptions>();
@@ -170,6 +210,7 @@ void register_bench_command(CLI::App& app) {
   register_fit_bench(bench);
   register_render_bench(bench);
   register_fur_bench(bench);
+  register_hierarchical_bench(bench);
   register_tradeoff_bench(bench);
 }
 

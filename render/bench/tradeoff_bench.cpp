@@ -2,6 +2,7 @@
 // each image against a converged CPU reference (tradeoff_bench.h). The report (CSV, plot,
 // summary) is tradeoff_report.cpp's.
 #include "lucent/render/tradeoff_bench.h"
+#include "lucent/render/render_bench.h"
 #include "lucent/render/technique.h"
 
 #include <algorithm>
@@ -427,6 +428,8 @@ class SceneBench {
   double truth_noise_ = 0;  // the path-traced truth's relative noise per pixel; 0 for the reference
 };
 
+}  // namespace
+
 // "CPU model, N threads; OpenGL renderer" for the report.
 std::string machine_description(const std::string& gl_renderer) {
   std::ifstream cpuinfo("/proc/cpuinfo");
@@ -440,8 +443,6 @@ std::string machine_description(const std::string& gl_renderer) {
   return cpu + ", " + std::to_string(std::thread::hardware_concurrency()) +
          " hardware threads; OpenGL: " + gl_renderer;
 }
-
-}  // namespace
 
 TradeoffSweep parse_tradeoff_sweep(const std::string& text) {
   if (text == "full") return TradeoffSweep::kFull;

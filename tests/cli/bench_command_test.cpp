@@ -28,6 +28,69 @@ TEST(BenchCommand, RenderWritesOneRowOfStageTimesPerMesh) {
   fs::remove_all(dir);
 }
 
+// Seed 004's modes on a small sphere: a row per configuration and thread count with the same links
+// whatever the threads, the links-against-error sweep (error falling as the links grow), the
+// figure; a mesh the paper timed gets its figures beside.
+TEST(BenchCommand, HierarchicalWritesModesLinksAndTheErrorSweep) {
+  const fs::path dir = scratch_dir("bench-hierarchical");
+  const auto r = run_lucent(
+      "bench hierarchical --meshes sphere:2,sphere:4@2016 --threads 1,2 "
+      "--frames 1 --error-mesh sphere:2 --out-dir \"" +
+      dir.string() + "\"");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::istringstream rows(read_text(dir / "hierarchical.csv"));
+  std::string line;
+  std::getline(rows, line);
+  EXPECT_EQ(
+      line.rfind("mesh,triangles,config,object_size_mm,threads,hierarchy_ms,link_ms,links,", 0),
+      0u);
+  std::vector<std::vector<std::string>> table;
+  while (std::getline(rows, line)) {
+    std::vector<std::string> cells;
+    std::string cell;
+    bool quoted = false;
+    for (char c : line) {
+      if (c == '"')
+        quoted = !quoted;
+      else if (c == ',' && !quoted)
+        cells.push_back(cell), cell.clear();
+      else
+        cell += c;
+    }
+    cells.push_back(cell);
+    table.push_back(cells);
+  }
+  ASSERT_EQ(table.size(), 8u);  // 2 meshes x 2 configurations x 2 thread counts
+  for (std::size_t i = 0; i < table.size(); i += 2) {
+    EXPECT_EQ(table[i][4], "1");
+    EXPECT_EQ(table[i + 1][4], "2");
+    EXPECT_EQ(table[i][7], table[i + 1][7]) << "links differ with the threads";
+    EXPECT_GT(std::stod(table[i][7]), 0);
+    EXPECT_GT(std::stod(table[i][10]), 0);  // a render-mode frame took time
+  }
+  EXPECT_EQ(table[0][0], "sphere:2");
+  EXPECT_EQ(table[0][15], "");     // 320 triangles: not a size the paper timed
+  EXPECT_EQ(table[4][1], "2016");  // simplified from 5120 to the paper's first size
+  EXPECT_EQ(table[4][15], "44.1");
+  EXPECT_EQ(table[4][16], "20");
+  std::istringstream sweep(read_text(dir / "hierarchical_error.csv"));
+  std::getline(sweep, line);
+  std::vector<std::pair<double, double>> points;  // links per triangle, error
+  while (std::getline(sweep, line)) {
+    std::vector<std::string> cells;
+    std::istringstream fields(line);
+    for (std::string cell; std::getline(fields, cell, ',');) cells.push_back(cell);
+    ASSERT_EQ(cells.size(), 12u) << line;
+    points.emplace_back(std::stod(cells[9]), std::stod(cells[10]));
+  }
+  ASSERT_EQ(points.size(), 6u);
+  EXPECT_GT(points.front().first, points.back().first);    // the tightest links the most
+  EXPECT_LT(points.front().second, points.back().second);  // and errs the least
+  EXPECT_LT(points.front().second, 0.01);
+  EXPECT_GT(fs::file_size(dir / "hierarchical.png"), 1000u);
+  fs::remove_all(dir);
+}
+
 TEST(BenchCommand, BadSettingIsOneLineAndNoFile) {
   const fs::path dir = scratch_dir("bench-render-bad");
   const fs::path csv = dir / "render.csv";

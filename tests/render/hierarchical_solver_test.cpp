@@ -135,6 +135,32 @@ TEST(HierarchicalSolver, RenderModeEqualsOnTheFly) {
   EXPECT_GT(b.stats().form_factor_calls, 0);
 }
 
+// The oracle's subproblems are linked on threads: the links, their order and so B are the same
+// to the last bit for any number, in each mode.
+TEST(HierarchicalSolver, TheSameLinksAndBOnAnyNumberOfThreads) {
+  Scene scene = sphere_scene(3, "marble");
+  scene.geometry_factor = true;
+  for (const Mode mode : {Mode::kRender, Mode::kOnTheFly}) {
+    Options one, three;
+    one.mode = three.mode = mode;
+    one.threads = 1;
+    three.threads = 3;
+    Solver a(scene, one), b(scene, three);
+    a.solve();
+    b.solve();
+    EXPECT_EQ(a.stats().links, b.stats().links);
+    EXPECT_EQ(a.stats().edge_segments, b.stats().edge_segments);
+    EXPECT_EQ(a.stats().point_samples, b.stats().point_samples);
+    for (std::size_t t = 0; t < a.face_B().size(); ++t)
+      for (int c = 0; c < 3; ++c)
+        ASSERT_EQ(a.face_B()[t][std::size_t(c)], b.face_B()[t][std::size_t(c)]);
+    EXPECT_GT(a.stats().memory_mib, 0);
+  }
+  Options bad;
+  bad.threads = -1;
+  EXPECT_THROW(Solver(scene, bad), Error);
+}
+
 // A deformation, then incremental frames (a small budget) until they agree with a from-scratch
 // solve of the deformed mesh; a material change likewise.
 TEST(HierarchicalSolver, IncrementalConvergesToOnTheFly) {
