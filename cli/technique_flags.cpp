@@ -140,6 +140,10 @@ void add_maps_flags(CLI::App* cmd, render::RenderSettings& s, render::RadianceMa
   flag(cmd, g, "--maps-max-blur", "--max-blur", m.max_blur_level,
        "mip blur levels at the first frame, fewer as frames accumulate (0 = none; -1: none with "
        "the profile disc, 2 with the exponential one)");
+  choice(cmd, g, "--maps-layer-weights", "", m.cos_weighted_layers,
+         std::vector<std::pair<std::string, bool>>{{"cos", true}, {"equal", false}},
+         "the final pass's mean over the layers that see a point: cos (by n . w_k, the layer's "
+         "texel density there) or equal (Dal Corso 2014)");
 }
 
 void add_sh_flags(CLI::App* cmd, render::ShOptions& o) {

@@ -141,6 +141,32 @@ TEST_F(RadianceMapsTest, DoublingTheLightDoublesTheImage) {
   }
 }
 
+// The seed's equal layer weights (--maps-layer-weights equal) reach the final pass: coarse layers
+// (K 8, 32 texels) weigh a point's grazing views as much as its facing ones, which moves the image.
+TEST_F(RadianceMapsTest, EqualLayerWeightsAreTheSeedsAndChangeTheImage) {
+  const Scene scene = sphere_scene(32, "potato");
+  RenderSettings settings = tiny_settings(2);
+  settings.radiance_map_size = 32;
+  ImageRgb images[2];
+  for (int equal = 0; equal < 2; ++equal) {
+    RadianceMapOptions options;
+    options.cos_weighted_layers = equal == 0;
+    RadianceMapRenderer renderer;
+    renderer.setup(scene, settings, options);
+    while (renderer.render_frame()) {
+    }
+    images[equal] = renderer.read_image();
+  }
+  double sum_cos = 0, sum_diff = 0;
+  for (std::size_t i = 0; i < images[0].data.size(); ++i) {
+    ASSERT_TRUE(std::isfinite(images[1].data[i]));
+    sum_cos += std::abs(images[0].data[i]);
+    sum_diff += std::abs(images[1].data[i] - images[0].data[i]);
+  }
+  EXPECT_GT(sum_diff, 0.005 * sum_cos);
+  EXPECT_LT(sum_diff, 0.5 * sum_cos);  // a change of weights, not of what is gathered
+}
+
 TEST_F(RadianceMapsTest, AccumulationStopsAfterTFrames) {
   const Scene scene = sphere_scene(32, "potato");
   const RenderSettings settings = tiny_settings(3);

@@ -296,12 +296,16 @@ struct Solver::Impl {
         ++planned;
       }
     }
+    const std::size_t window = cursor;
     cursor = links.empty() ? 0 : (cursor + visited) % links.size();
     // Promotion, one level: (c0, E) and (c1, E) with c0, c1 the children of P become (P, E) when
-    // the oracle links (P, E); likewise (R, c0) and (R, c1) become (R, Q) for E's side.
+    // the oracle links (P, E); likewise (R, c0) and (R, c1) become (R, Q) for E's side. Among the
+    // links this frame visited (the oracle makes siblings' links one after the other), so that a
+    // frame costs its budget, not the number of links.
     for (int side = 0; side < 2; ++side) {
       std::unordered_map<std::uint64_t, std::array<int, 2>> siblings;  // (parent, other) -> links
-      for (std::size_t i = 0; i < links.size(); ++i) {
+      for (std::size_t k = 0; k < visited; ++k) {
+        const std::size_t i = (window + k) % links.size();
         if (removed[i] || link_geometry[i] != geometry_version) continue;
         const int moving = side == 0 ? links[i].R : links[i].E;
         const int other = side == 0 ? links[i].E : links[i].R;
@@ -328,23 +332,25 @@ struct Solver::Impl {
     for (std::size_t i : refresh) targets.push_back(&links[i]);
     for (Link& l : added) targets.push_back(&l);
     evaluate(targets);
-    std::vector<Link> kept;
-    std::vector<std::uint32_t> km, kg;
-    kept.reserve(links.size() + added.size());
+    // The removed links compacted away in place (in order), the new ones appended.
+    std::size_t kept = 0;
     for (std::size_t i = 0; i < links.size(); ++i) {
       if (removed[i]) continue;
-      kept.push_back(links[i]);
-      km.push_back(link_material[i]);
-      kg.push_back(link_geometry[i]);
+      if (kept != i) {
+        links[kept] = links[i];
+        link_material[kept] = link_material[i];
+        link_geometry[kept] = link_geometry[i];
+      }
+      ++kept;
     }
+    links.resize(kept);
+    link_material.resize(kept);
+    link_geometry.resize(kept);
     for (const Link& l : added) {
-      kept.push_back(l);
-      km.push_back(material_version);
-      kg.push_back(geometry_version);
+      links.push_back(l);
+      link_material.push_back(material_version);
+      link_geometry.push_back(geometry_version);
     }
-    links = std::move(kept);
-    link_material = std::move(km);
-    link_geometry = std::move(kg);
   }
 
   double memory_mib() const {

@@ -23,6 +23,7 @@ void RadianceMapOptions::validate() const {
 std::string RadianceMapOptions::to_string() const {
   std::ostringstream s;
   s << "RadianceMapOptions{max_blur_level=" << max_blur_level
+    << ", layer_weights=" << (cos_weighted_layers ? "cos" : "equal")
     << ", shadow_bias_texels=" << shadow_bias_texels << ", shrink_texels=" << shrink_texels
     << ", new_radii_each_frame=" << new_radii_each_frame
     << ", convergence_tolerance=" << convergence_tolerance << ", time_stages=" << time_stages

@@ -134,6 +134,7 @@ void RadianceMapRenderer::Impl::render_final() {
   glUniform1f(final_program.location("u_texel_mm"), texel_mm);
   glUniform1f(final_program.location("u_depth_range_mm"), any_layer.far_mm - any_layer.near_mm);
   glUniform1f(final_program.location("u_shrink_mm"), options.shrink_texels * texel_mm);
+  glUniform1i(final_program.location("u_cos_weighted_layers"), options.cos_weighted_layers ? 1 : 0);
   glUniform3fv(final_program.location("u_eye"), 1, scene.camera.eye.data());
   glUniform1i(final_program.location("u_has_environment"),
               final.has_environment() && options.environment_reflection ? 1 : 0);

@@ -38,6 +38,10 @@ struct RadianceMapOptions {
   /// 0.034 / 0.024 / 0.006: the profile disc's first frames are already smooth, and the blur only
   /// smears thin parts into their surroundings.
   int max_blur_level = -1;
+  /// The final pass's mean over the layers that see x_o: weighted by cos_k = n_o . w_k, the
+  /// layer's texel density on the surface (lucent's), or equal weights (Dal Corso 2014 §5.4.4;
+  /// `--maps-layer-weights equal`, for the thesis's own configuration).
+  bool cos_weighted_layers = true;
   /// Depth bias of the layer visibility test, in radiance-map texels of world size (seed §5.4.3).
   float shadow_bias_texels = 1.5f;
   /// Shrink of x_o along the layer plane against seams, in texels (seed §5.4.4: "one pixel").

@@ -41,6 +41,7 @@ uniform float u_depth_bias_mm;  // eps_b, mm
 uniform float u_texel_mm;       // a radiance-map texel, mm
 uniform float u_depth_range_mm; // far - near of the layer cameras (depth 0..1), mm
 uniform float u_shrink_mm;      // eps_c
+uniform bool u_cos_weighted_layers;  // false: the seed's equal weights
 uniform vec3 u_eye;          // mm
 uniform float u_eta;
 uniform bool u_has_environment;
@@ -187,8 +188,9 @@ void main() {
     // 19% off a flat slab.
     vec3 value = r.rgb / r.a;
     if (displaced) value = displaced_exit(k, x_s, exit_shift, value);
-    sum += visible * cos_k * value;
-    seen += visible * cos_k;
+    float weight = u_cos_weighted_layers ? cos_k : 1.0;
+    sum += visible * weight * value;
+    seen += visible * weight;
   }
   vec3 L_ss = seen > 0.0 ? sum / seen : vec3(0.0);
   float F_r = fresnel_reflectance(dot(n_o, w_o), u_eta);
