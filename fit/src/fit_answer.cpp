@@ -1,6 +1,7 @@
 // The stages of a fit that judge its answer (profile_fit.h): the model chosen and why, the
 // tabulated model's own systematic, a slab outside its tables, the cheaper models' adequacy and the
 // g systematic, and what the answer assumes.
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -97,6 +98,14 @@ void ProfileFit::table_systematic() {
   // log rho.
   constexpr int kBootstrap = 8;
   constexpr double kTableAccuracy = 0.01;
+  // The bootstrap and accuracy refits start at the answer and move from it by a fraction of its
+  // SD, so 3 solver steps reach their solution (the bootstrap's own sampling error
+  // with 8 draws is ~25%): capped (FitOptions::systematic_refit_iterations), they no longer crawl
+  // to the full tolerances, which made most of a tabulated 2D fit's time (issue 37).
+  FitOptions refit_options = options;
+  if (const int cap = options.systematic_refit_iterations; cap > 0)
+    refit_options.max_iterations =
+        options.max_iterations > 0 ? std::min(options.max_iterations, cap) : cap;
   const std::array<StartValues, 3> st = started_from(result.chosen);
   const std::array<double, 3> ex = exclusion(FitModel::kTabulated, st);
   std::array<std::array<double, 4>, 3> moments{};  // sum a, sum a^2, sum s, sum s^2
@@ -104,7 +113,7 @@ void ProfileFit::table_systematic() {
   int ignored = 0;
   for (int b = 0; b < kBootstrap; ++b) {
     const materials::TabulatedProfile shaken = tab->perturbed(1000 + std::uint64_t(b));
-    const ModelFit f = solve(data, options, FitModel::kTabulated, &shaken, result.chosen.eta,
+    const ModelFit f = solve(data, refit_options, FitModel::kTabulated, &shaken, result.chosen.eta,
                              relative, ex, st, channels, &ignored);
     for (int c = 0; c < 3; ++c) {
       const double a = f.channels[c].sigma_a, s = f.channels[c].sigma_s_reduced;
@@ -113,7 +122,7 @@ void ProfileFit::table_systematic() {
   }
   for (int shape : {1, 2}) {
     const ModelFit f =
-        solve(data, options, FitModel::kTabulated, tab, result.chosen.eta, relative, ex, st,
+        solve(data, refit_options, FitModel::kTabulated, tab, result.chosen.eta, relative, ex, st,
               channels, &ignored, ModelPerturbation{kTableAccuracy, shape});
     for (int c = 0; c < 3; ++c) {
       shift2[c][0] += std::pow(f.channels[c].sigma_a - result.chosen.channels[c].sigma_a, 2);

@@ -189,6 +189,46 @@ struct ChannelResiduals {
   }
 };
 
+// The scale free (a calibration prior, or a relative fit) and eta held: the residual is affine in
+// the scale's factor exp(log scale) (linear form) or in log scale itself (log-ratio form), so its
+// column is analytic and only {log sigma_a, log sigma_s'} need Jets: Jets of 2, not the 4 of
+// ProfileResiduals over {ab, log scale, eta}, half the derivative work of the 2D fits, which spend
+// most of their time in Jet arithmetic. The same solution and covariance as the AutoDiff
+// ProfileResiduals (fit_residuals_test.cpp holds them together).
+class ScaledChannelCost : public ceres::CostFunction {
+ public:
+  // Parameter blocks: {log sigma_a, log sigma_s'} and {log scale}.
+  ScaledChannelCost(ProfileResiduals full, const double* eta) : full_(full), eta_(eta) {
+    set_num_residuals(int(full.obs->log_value.size()));
+    mutable_parameter_block_sizes()->push_back(2);
+    mutable_parameter_block_sizes()->push_back(1);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const double* ab = parameters[0];
+    const double log_scale = parameters[1][0];
+    if (!jacobians) return full_.evaluate(ab, log_scale, *eta_, residuals);
+    using Jet2 = ceres::Jet<double, 2>;
+    const Jet2 ab_jet[2] = {Jet2(ab[0], 0), Jet2(ab[1], 1)};
+    std::vector<Jet2> r(static_cast<std::size_t>(num_residuals()));
+    if (!full_.evaluate(ab_jet, Jet2(log_scale), Jet2(*eta_), r.data())) return false;
+    const Observations& o = *full_.obs;
+    for (std::size_t i = 0; i < r.size(); ++i) {
+      residuals[i] = r[i].a;
+      if (jacobians[0]) jacobians[0][2 * i] = r[i].v[0], jacobians[0][2 * i + 1] = r[i].v[1];
+      // Linear: r = (e^s m - v) / se, so dr/ds = e^s m / se = r + v / se; log-ratio: dr/ds = w.
+      if (jacobians[1])
+        jacobians[1][i] = o.linear ? r[i].a + o.value[i] * o.inv_se[i] : o.inv_rel_se[i];
+    }
+    return true;
+  }
+
+ private:
+  ProfileResiduals full_;
+  const double* eta_;
+};
+
 // The standard dipole with a hand-written Jacobian (scale and eta held): annuli, or pixel
 // footprints.
 class DipoleRadialCost : public ceres::CostFunction {

@@ -33,16 +33,17 @@ namespace lucent::fit {
 namespace {
 
 using detail::CaptureGeometry;
-using detail::GaussLegendre;
-using detail::ModelPerturbation;
-using detail::start_values;
-using detail::StartValues;
-using detail::Observations;
-using detail::ProfileResiduals;
 using detail::ChannelResiduals;
 using detail::DipoleRadialCost;
-using detail::ScalePrior;
+using detail::GaussLegendre;
+using detail::ModelPerturbation;
+using detail::Observations;
 using detail::observations_for;
+using detail::ProfileResiduals;
+using detail::ScaledChannelCost;
+using detail::ScalePrior;
+using detail::start_values;
+using detail::StartValues;
 
 }  // namespace
 
@@ -150,6 +151,11 @@ void ProfileSolve::add_observations() {
         auto* cost = new ceres::AutoDiffCostFunction<ChannelResiduals, ceres::DYNAMIC, 2>(
             new ChannelResiduals{{&o, model, gl, table, perturbation}, scale, &p.eta}, int(o.log_value.size()));
         problem.AddResidualBlock(cost, nullptr, p.ab[c].data());
+        record(c, &o, int(o.log_value.size()));
+      } else if (options.loss == LossKind::kNone && !options.fit_ior) {
+        problem.AddResidualBlock(
+            new ScaledChannelCost({&o, model, gl, table, perturbation}, &p.eta), nullptr,
+            p.ab[c].data(), scale);
         record(c, &o, int(o.log_value.size()));
       } else if (options.loss == LossKind::kNone) {
         auto* cost = new ceres::AutoDiffCostFunction<ProfileResiduals, ceres::DYNAMIC, 2, 1, 1>(
