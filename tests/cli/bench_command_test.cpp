@@ -83,7 +83,7 @@ TEST(BenchCommand, HierarchicalWritesModesLinksAndTheErrorSweep) {
     ASSERT_EQ(cells.size(), 12u) << line;
     points.emplace_back(std::stod(cells[9]), std::stod(cells[10]));
   }
-  ASSERT_EQ(points.size(), 6u);
+  ASSERT_EQ(points.size(), 7u);
   EXPECT_GT(points.front().first, points.back().first);    // the tightest links the most
   EXPECT_LT(points.front().second, points.back().second);  // and errs the least
   EXPECT_LT(points.front().second, 0.01);

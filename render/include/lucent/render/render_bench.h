@@ -78,7 +78,8 @@ struct HierarchicalBenchOptions {
   /// epsilon_1, epsilon_2, near (sr) and planarity per point of the error sweep.
   std::vector<std::array<double, 4>> error_sweep = {
       {0.02, 0.2, 0.02, 0.99}, {0.05, 0.4, 0.05, 0.99}, {0.1, 0.4, 0.05, 0.95},
-      {0.1, 0.8, 0.05, 0.95},  {0.2, 0.8, 0.05, 0.9},   {0.2, 1.0, 0.1, 0.9}};
+      {0.1, 0.8, 0.05, 0.95},  {0.1, 0.8, 0.2, 0.95},   {0.2, 0.8, 0.05, 0.9},
+      {0.2, 1.0, 0.1, 0.9}};
 };
 struct HierarchicalBenchResult {
   int rows = 0, error_rows = 0;
