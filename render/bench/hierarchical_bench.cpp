@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <ostream>
 #include <sstream>
 #include <thread>
@@ -69,7 +70,8 @@ double relative_rms(const std::vector<Rgb>& b, const std::vector<Rgb>& ref) {
 
 // The key light turned by `degrees` about the vertical.
 std::vector<Light> turned(std::vector<Light> lights, double degrees) {
-  const float c = float(std::cos(degrees * M_PI / 180)), s = float(std::sin(degrees * M_PI / 180));
+  const double a = degrees * std::numbers::pi / 180;
+  const float c = float(std::cos(a)), s = float(std::sin(a));
   for (Light& l : lights) {
     if (l.type == LightType::kDirectional) {
       l.direction = Vec3f(c * l.direction.x() + s * l.direction.z(), l.direction.y(),
@@ -171,6 +173,10 @@ Scene bench_scene(const std::string& mesh, const std::string& material, const Co
 HierarchicalBenchResult run_hierarchical_bench(const HierarchicalBenchOptions& options,
                                                std::ostream& log) {
   if (options.frames < 1) throw Error("bench hierarchical: expected --frames >= 1");
+  // Every mesh and the material read first: a bad name fails at once, not after minutes of rows.
+  materials::load_material(options.material);
+  for (const std::string& mesh : options.meshes) load_mesh(mesh, 100.0);
+  load_mesh(options.error_mesh, 100.0);
   HierarchicalBenchResult result;
   const std::string machine = machine_description("not used");
   const std::string cpu = machine.substr(0, machine.find(';'));
@@ -180,9 +186,10 @@ HierarchicalBenchResult run_hierarchical_bench(const HierarchicalBenchOptions& o
   error_csv << "mesh,triangles,object_size_mm,epsilon_1,epsilon_2,near,planarity,rule,links,"
                "links_per_triangle,relative_rms_B,link_ms\n";
   PlotSeries sweep_series;
-  sweep_series.label = "lucent (" + options.error_mesh + ", 25 mm)";
+  const Config seed = configs(options)[1];
+  sweep_series.label =
+      "lucent (" + options.error_mesh + ", " + std::to_string(int(seed.object_size_mm)) + " mm)";
   {
-    const Config seed = configs(options)[1];
     const Scene scene = bench_scene(options.error_mesh, options.material, seed);
     std::vector<Rgb> reference;
     for (const auto& [e1, e2, near, planarity] : options.error_sweep) {
@@ -203,9 +210,10 @@ HierarchicalBenchResult run_hierarchical_bench(const HierarchicalBenchOptions& o
       }
       const double error = relative_rms(solver.face_B(), reference);
       const double per = double(solver.stats().links) / double(scene.mesh.triangles.size());
-      error_csv << options.error_mesh << ',' << scene.mesh.triangles.size() << ",25," << e1 << ','
-                << e2 << ',' << near << ',' << planarity << ",gauss2," << solver.stats().links
-                << ',' << per << ',' << error << ',' << solver.stats().link_ms << '\n';
+      error_csv << options.error_mesh << ',' << scene.mesh.triangles.size() << ','
+                << seed.object_size_mm << ',' << e1 << ',' << e2 << ',' << near << ',' << planarity
+                << ",gauss2," << solver.stats().links << ',' << per << ',' << error << ','
+                << solver.stats().link_ms << '\n';
       sweep_series.x.push_back(per);
       sweep_series.y.push_back(100 * error);
       log << "  epsilon " << e1 << '/' << e2 << " near " << near << " planarity " << planarity
@@ -269,8 +277,6 @@ HierarchicalBenchResult run_hierarchical_bench(const HierarchicalBenchOptions& o
       }
     }
   }
-  write_file_atomically(options.out_dir / "hierarchical.csv", csv.str());
-  write_file_atomically(options.out_dir / "hierarchical_error.csv", error_csv.str());
 
   // The figure: the modes' frames against the paper's, and the links against the error.
   PlotFigure figure;
@@ -308,7 +314,10 @@ HierarchicalBenchResult run_hierarchical_bench(const HierarchicalBenchOptions& o
       "Vertical lines: the seed's 44.1 links a triangle at 2,016 triangles and twice "
       "that. " +
       machine.substr(0, machine.find(';'))};
+  // The figure first: the one write that can fail on its own (no cairo driver) before the CSVs.
   imaging::write_plot(options.out_dir / "hierarchical.png", figure);
+  write_file_atomically(options.out_dir / "hierarchical.csv", csv.str());
+  write_file_atomically(options.out_dir / "hierarchical_error.csv", error_csv.str());
   return result;
 }
 

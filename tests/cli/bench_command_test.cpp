@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <sstream>
 #include <string>
@@ -70,7 +71,9 @@ TEST(BenchCommand, HierarchicalWritesModesLinksAndTheErrorSweep) {
   }
   EXPECT_EQ(table[0][0], "sphere:2");
   EXPECT_EQ(table[0][15], "");     // 320 triangles: not a size the paper timed
-  EXPECT_EQ(table[4][1], "2016");  // simplified from 5120 to the paper's first size
+  // Simplified from 5120 to about the paper's first size (meshoptimizer: at most what is asked).
+  EXPECT_LE(std::stoi(table[4][1]), 2016);
+  EXPECT_GE(std::stoi(table[4][1]), 1916);
   EXPECT_EQ(table[4][15], "44.1");
   EXPECT_EQ(table[4][16], "20");
   std::istringstream sweep(read_text(dir / "hierarchical_error.csv"));
@@ -88,6 +91,19 @@ TEST(BenchCommand, HierarchicalWritesModesLinksAndTheErrorSweep) {
   EXPECT_LT(points.front().second, points.back().second);  // and errs the least
   EXPECT_LT(points.front().second, 0.01);
   EXPECT_GT(fs::file_size(dir / "hierarchical.png"), 1000u);
+  fs::remove_all(dir);
+}
+
+// A mesh that does not exist fails at once, with one line naming it, before any row is written.
+TEST(BenchCommand, HierarchicalBadMeshIsOneLineAndNoFile) {
+  const fs::path dir = scratch_dir("bench-hierarchical-bad");
+  const auto r = run_lucent("bench hierarchical --meshes sphere:1,nothing --frames 1 --out-dir \"" +
+                            dir.string() + "\"");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("'nothing'"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "hierarchical.csv"));
+  EXPECT_FALSE(fs::exists(dir / "hierarchical.png"));
   fs::remove_all(dir);
 }
 

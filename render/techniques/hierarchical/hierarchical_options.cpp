@@ -43,7 +43,8 @@ void Options::validate() const {
   }
   if (budget < 1) throw Error("--hierarchical-budget: expected at least 1 form factor per frame");
   if (threads < 0)
-    throw Error("--threads: expected 0 (every core) or more, got " + std::to_string(threads));
+    throw Error("--hierarchical-threads: expected 0 (every core) or more, got " +
+                std::to_string(threads));
 }
 
 std::string Options::to_string() const {

@@ -88,6 +88,7 @@ struct Solver::Impl {
   int threads = 1;
   std::vector<std::uint32_t> link_material, link_geometry;  // versions each link was made at
   std::size_t cursor = 0;
+  std::size_t stale_links = 0;  // kIncremental: links made at an older material or geometry
   std::vector<Rgb> E, B, face_B, vertex_B, face_E;
   Stats stats;
   Tally tally;  // the frame's factor evaluations
@@ -254,6 +255,7 @@ struct Solver::Impl {
       links.insert(links.end(), m.begin(), m.end());
       std::vector<Link>().swap(m);
     }
+    stale_links = 0;
     link_material.assign(links.size(), material_version);
     link_geometry.assign(links.size(), geometry_version);
     linked = true;
@@ -279,7 +281,8 @@ struct Solver::Impl {
   // The links to re-evaluate are chosen first (the oracle is cheap) and their factors evaluated
   // after, in parallel.
   void repair() {
-    long planned = 0;  // factor evaluations
+    if (stale_links == 0) return;  // nothing changed since the links were last repaired
+    long planned = 0;              // factor evaluations, promotions' included
     std::vector<Link> added;
     std::vector<std::size_t> refresh;
     std::vector<char> removed(links.size(), 0);
@@ -289,6 +292,7 @@ struct Solver::Impl {
       ++visited;
       Link& l = links[i];
       if (link_material[i] == material_version && link_geometry[i] == geometry_version) continue;
+      --stale_links;
       const Decision d = link_geometry[i] == geometry_version ? Decision::kLink : decide(l.R, l.E);
       if (d == Decision::kLink) {
         refresh.push_back(i);
@@ -309,11 +313,11 @@ struct Solver::Impl {
       }
     }
     const std::size_t window = cursor;
-    cursor = links.empty() ? 0 : (cursor + visited) % links.size();
+    const std::size_t next = links.empty() ? 0 : (cursor + visited) % links.size();
     // Promotion, one level: (c0, E) and (c1, E) with c0, c1 the children of P become (P, E) when
     // the oracle links (P, E); likewise (R, c0) and (R, c1) become (R, Q) for E's side. Among the
-    // links this frame visited (the oracle makes siblings' links one after the other), so that a
-    // frame costs its budget, not the number of links.
+    // links this frame visited (the oracle makes siblings' links one after the other), within the
+    // budget, so that a frame costs its budget, not the number of links.
     for (int side = 0; side < 2; ++side) {
       std::unordered_map<std::uint64_t, std::array<int, 2>> siblings;  // (parent, other) -> links
       for (std::size_t k = 0; k < visited; ++k) {
@@ -333,20 +337,26 @@ struct Solver::Impl {
         if (pair[1] < 0) continue;
         const int p = int(key >> 32), other = int(key & 0xffffffffu);
         const int r = side == 0 ? p : other, e = side == 0 ? other : p;
+        if (planned >= o.budget) break;
         if (decide(r, e) != Decision::kLink) continue;
         removed[std::size_t(pair[0])] = removed[std::size_t(pair[1])] = 1;
+        ++planned;
         added.push_back({r, e, {}});
         ++stats.promoted;
       }
     }
     std::vector<Link*> targets;
     targets.reserve(refresh.size() + added.size());
-    for (std::size_t i : refresh) targets.push_back(&links[i]);
+    for (std::size_t i : refresh)
+      if (!removed[i]) targets.push_back(&links[i]);  // not if promoted away since
     for (Link& l : added) targets.push_back(&l);
     evaluate(targets);
-    // The removed links compacted away in place (in order), the new ones appended.
+    // The removed links compacted away in place (in order), the new ones appended; the cursor
+    // follows the first link not visited to its new index.
     std::size_t kept = 0;
+    cursor = 0;
     for (std::size_t i = 0; i < links.size(); ++i) {
+      if (i == next) cursor = kept;
       if (removed[i]) continue;
       if (kept != i) {
         links[kept] = links[i];
@@ -355,6 +365,7 @@ struct Solver::Impl {
       }
       ++kept;
     }
+    if (cursor >= kept) cursor = 0;
     links.resize(kept);
     link_material.resize(kept);
     link_geometry.resize(kept);
@@ -455,6 +466,10 @@ struct Solver::Impl {
           link_all();
         }
       } else {
+        // A new material or geometry makes every link stale (each keeps the versions it was made
+        // at); repair() takes them a budget at a time.
+        if (material_version_seen != material_version || geometry_version_seen != geometry_version)
+          stale_links = links.size();
         repair();
       }
       material_version_seen = material_version;

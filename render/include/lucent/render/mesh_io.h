@@ -28,7 +28,8 @@ Mesh parse_obj(std::string_view text, const std::string& source);
 /// sub-millimetre precision scattering needs).
 inline constexpr double kMaxObjectSizeMm = 1e6;
 
-/// `mesh` simplified to at most `target_triangles` (meshoptimizer's quadric edge collapses, corners
+/// `mesh` simplified to about `target_triangles`, at most that where collapses allow (a warning
+/// on stderr when over 1.1 times it; meshoptimizer's quadric edge collapses, corners
 /// at one position welded first; positions and triangles only: finish_mesh gives the normals). What
 /// load_mesh does for "NAME@T". Throws lucent::Error naming `name` unless 4 <= T < the mesh's
 /// count.

@@ -185,7 +185,7 @@ void main() {
     // Weighted by cos_k, the layer's texel density on the surface: a layer that sees x_o edge-on
     // spreads one texel over texel / cos_k of surface (and of the surfaces beside it), so its
     // value is the least accurate; equal weights let one grazing layer of K 8 at W_s 32 take
-    // 19% off a flat slab.
+    // 19% off a flat slab. (u_cos_weighted_layers false: the seed's equal weights.)
     vec3 value = r.rgb / r.a;
     if (displaced) value = displaced_exit(k, x_s, exit_shift, value);
     float weight = u_cos_weighted_layers ? cos_k : 1.0;
