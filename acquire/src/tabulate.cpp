@@ -112,10 +112,14 @@ void walk_photon(const Walk& m, Xoshiro256StarStar& rng, double max_path, Escape
   for (;;) {
     double step = exponential.sample(rng) * inv_sigma_t;
     for (;;) {  // boundaries crossed before the next collision: escape or internal reflection
+      // Tested on where the flight ends, a well-predicted branch (the sign of uz is a coin toss
+      // each collision); the division only on a crossing (z <= 0 inside: z_end >= 0 needs uz > 0
+      // or uz = 0 on the surface itself).
+      const double z_end = z + uz * step;
       double d;
-      if (uz > 0)
+      if (z_end >= 0 && uz > 0)
         d = -z / uz;
-      else if (uz < 0 && m.bottom < std::numeric_limits<double>::infinity())
+      else if (z_end <= -m.bottom && uz < 0)
         d = (z + m.bottom) / -uz;
       else
         break;
