@@ -171,11 +171,11 @@ inline void sample_isotropic(Xoshiro256StarStar& rng, double& ux, double& uy, do
   uz = 1 - 2 * r2;
 }
 
-
 /// Henyey-Greenstein constants for one g.
 struct HenyeyGreenstein {
   double g = 0;
-  double one_plus_g2 = 1, one_minus_g2 = 1, inv_2g = 0, pdf_scale = 1 / (4 * 3.14159265358979323846);
+  double one_plus_g2 = 1, one_minus_g2 = 1, inv_2g = 0,
+         pdf_scale = 1 / (4 * 3.14159265358979323846);
   explicit HenyeyGreenstein(double g_ = 0)
       : g(g_),
         one_plus_g2(1 + g_ * g_),
@@ -192,8 +192,9 @@ struct HenyeyGreenstein {
 /// Turns the unit direction (ux, uy, uz) by a Henyey-Greenstein deflection (inversion as in MCML,
 /// guarded against rounding past +-1) and a uniform azimuth. For |g| < 1e-6 the inversion formula
 /// is singular (0/0): a uniform direction on the sphere instead.
-inline void scatter_henyey_greenstein(const HenyeyGreenstein& hg, Xoshiro256StarStar& rng,
-                                      double& ux, double& uy, double& uz) {
+[[gnu::always_inline]] inline void scatter_henyey_greenstein(const HenyeyGreenstein& hg,
+                                                             Xoshiro256StarStar& rng, double& ux,
+                                                             double& uy, double& uz) {
   if (std::abs(hg.g) < 1e-6) {
     sample_isotropic(rng, ux, uy, uz);
     return;
