@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <functional>
 #include <numbers>
@@ -278,6 +279,65 @@ TEST(HierarchicalFormFactor, LargeTessellatedPlaneGivesTheTotalDiffuseReflectanc
       EXPECT_LT(relative(sum, R_tot), 2e-4) << name << " " << ch << ": " << sum << " vs " << R_tot;
     }
   }
+}
+
+// The three channels in one pass give each channel's own value and counts, bit for bit: random
+// pentagons (one concave) about receivers near and far, every rule, with and without the global
+// condition, both placements, and a channel that does not scatter.
+TEST(HierarchicalFormFactor, ThreeChannelsAtOnceEqualEachChannelAlone) {
+  std::array<Coefficients, 3> black_green;
+  for (int ch = 0; ch < 3; ++ch) black_green[std::size_t(ch)] = coefficients("marble", ch);
+  black_green[1] = materials::derive_coefficients(
+      materials::Medium<double>::from_reduced(1.0, 0.0, 1.3));  // sigma_s' 0: no scattering
+  std::vector<std::array<Coefficients, 3>> materials_rgb = {black_green};
+  for (const char* name : {"marble", "skimmilk", "ketchup"}) {
+    std::array<Coefficients, 3> c;
+    for (int ch = 0; ch < 3; ++ch) c[std::size_t(ch)] = coefficients(name, ch);
+    materials_rgb.push_back(c);
+  }
+  const PlaneFrame plane = PlaneFrame::from_normal(Vec3d(0.1, -0.2, 0.3), Vec3d(0.2, -0.1, 1));
+  std::uint64_t state = 12345;
+  auto uniform = [&state] {  // a fixed LCG: the same polygons on every platform
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return double(state >> 11) / double(1ull << 53);
+  };
+  long compared = 0;
+  for (const auto& c : materials_rgb) {
+    const double scale = 1 / c[0].sigma_tr;
+    for (int polygon = 0; polygon < 12; ++polygon) {
+      std::vector<Vec2d> starts, ends;
+      const int n = 5;
+      for (int k = 0; k < n; ++k) {
+        const double angle = 2 * std::numbers::pi * (k + 0.8 * uniform()) / n;
+        const double radius = scale * (k == 2 && polygon % 2 ? 0.2 : 0.5 + uniform());
+        starts.push_back(Vec2d(radius * std::cos(angle), radius * std::sin(angle)));
+      }
+      for (int k = 0; k < n; ++k) ends.push_back(starts[std::size_t((k + 1) % n)]);
+      const Vec3d x_o = plane.origin + scale * (3 * uniform() - 1.5) * plane.u +
+                        scale * (3 * uniform() - 1.5) * plane.v +
+                        scale * (polygon % 3 ? 0.5 * uniform() : 0.0) * plane.n;
+      const Vec3d n_o = (plane.n + Vec3d(0.3 * uniform(), -0.2, 0.1)).normalized();
+      for (const SegmentRule rule : {SegmentRule::kSeedMidpoint, SegmentRule::kGauss2})
+        for (const bool global : {true, false})
+          for (const DipolePlacement p : {DipolePlacement::kChord, DipolePlacement::kSeed3d}) {
+            FormFactorOptions o;
+            o.rule = rule;
+            o.global_condition = global;
+            o.placement = p;
+            FormFactorCounters each, together;
+            const std::array<double, 3> F =
+                edges_form_factor_rgb(c, x_o, n_o, plane, starts, ends, o, &together);
+            for (std::size_t ch = 0; ch < 3; ++ch) {
+              EXPECT_EQ(F[ch], edges_form_factor(c[ch], x_o, n_o, plane, starts, ends, o, &each))
+                  << polygon << " channel " << ch << " " << to_string(rule) << " " << to_string(p);
+              ++compared;
+            }
+            EXPECT_EQ(together.calls, each.calls);
+            EXPECT_EQ(together.segments, each.segments);
+          }
+    }
+  }
+  EXPECT_EQ(compared, 4 * 12 * 8 * 3);
 }
 
 TEST(HierarchicalFormFactor, FiniteAndZeroWhereItMustBe) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <numbers>
 
@@ -95,50 +96,112 @@ double integrate_segments(const EdgeIntegrand& g, double R, double t_lo, double 
   return 0.5 * L * (g(t0 - h) + g(t0 + h));
 }
 
-// Both sources of the chord placement share the pole, so the subdivision (which depends on the
-// edge, the pole and sigma only) and the angle: their integrands are summed in one pass.
-struct PairIntegrand {
-  EdgeIntegrand real, virt;
+// The sources of the chord placement (both, and every colour channel's) share the pole, so the
+// edge's geometry and angle; the subdivision depends on the edge, the pole and sigma only. N
+// channels' integrands are summed in one traversal: a channel stops splitting where it alone would
+// (L sigma < c is its own), and each channel's segments, values and sums are those of its own
+// traversal, bit for bit.
+template <std::size_t N>
+struct SharedPoleIntegrand {
+  double R2 = 0;
+  std::array<double, N> sigma{};
+  std::array<std::array<double, 2>, N> H2{};  // real, virtual source
+  // EdgeIntegrand's value, r2 = R^2 + t^2 computed once for all.
+  double operator()(std::size_t ch, std::size_t k, double r2) const {
+    const double s = std::sqrt(r2 + H2[ch][k]);
+    return std::exp(-sigma[ch] * s) / (s * r2);
+  }
 };
 
-std::array<double, 2> integrate_pair(const PairIntegrand& g, double R, double t_lo, double t_hi,
-                                     int depth, const FormFactorOptions& o, long& segments) {
+template <std::size_t N>
+using SourceSums = std::array<std::array<double, 2>, N>;  // per channel: real, virtual
+
+// `active`: a bit per channel still integrating; out[ch] written for those only.
+template <std::size_t N>
+void integrate_shared_pole(const SharedPoleIntegrand<N>& g, double R, double t_lo, double t_hi,
+                           int depth, unsigned active, const FormFactorOptions& o, long& segments,
+                           SourceSums<N>& out) {
   const double L = t_hi - t_lo, t0 = 0.5 * (t_lo + t_hi);
   const double r0 = std::sqrt(R * R + t0 * t0);
-  const double sigma = g.real.sigma;
-  const bool fine =
-      L < o.edge_constant * r0 && (!o.global_condition || L * sigma < o.edge_constant);
-  if (!fine && depth < o.max_depth) {
-    const auto a = integrate_pair(g, R, t_lo, t0, depth + 1, o, segments);
-    const auto b = integrate_pair(g, R, t0, t_hi, depth + 1, o, segments);
-    return {a[0] + b[0], a[1] + b[1]};
+  const bool near_fine = L < o.edge_constant * r0;
+  unsigned split = 0;
+  for (std::size_t ch = 0; ch < N; ++ch) {
+    if (!(active >> ch & 1u)) continue;
+    const bool fine = near_fine && (!o.global_condition || L * g.sigma[ch] < o.edge_constant);
+    if (!fine && depth < o.max_depth) {
+      split |= 1u << ch;
+      continue;
+    }
+    segments += 2;  // one per source, as edge_term counts them
+    if (o.rule == SegmentRule::kSeedMidpoint) {
+      const double r2 = g.R2 + t0 * t0;
+      for (std::size_t k = 0; k < 2; ++k) out[ch][k] = g(ch, k, r2) * L;
+    } else {
+      const double h = 0.5 * L / std::sqrt(3.0);  // Gauss-Legendre nodes t0 -/+ L / (2 sqrt 3)
+      const double r2a = g.R2 + (t0 - h) * (t0 - h), r2b = g.R2 + (t0 + h) * (t0 + h);
+      for (std::size_t k = 0; k < 2; ++k) out[ch][k] = 0.5 * L * (g(ch, k, r2a) + g(ch, k, r2b));
+    }
   }
-  segments += 2;  // one per source, as edge_term counts them
-  if (o.rule == SegmentRule::kSeedMidpoint) return {g.real(t0) * L, g.virt(t0) * L};
-  const double h = 0.5 * L / std::sqrt(3.0);
-  return {0.5 * L * (g.real(t0 - h) + g.real(t0 + h)), 0.5 * L * (g.virt(t0 - h) + g.virt(t0 + h))};
+  if (!split) return;
+  SourceSums<N> a, b;
+  integrate_shared_pole(g, R, t_lo, t0, depth + 1, split, o, segments, a);
+  integrate_shared_pole(g, R, t0, t_hi, depth + 1, split, o, segments, b);
+  for (std::size_t ch = 0; ch < N; ++ch) {
+    if (!(split >> ch & 1u)) continue;
+    for (std::size_t k = 0; k < 2; ++k) out[ch][k] = a[ch][k] + b[ch][k];
+  }
 }
 
-// edge_term for the two sources of one pole at once: Gamma_e of the real plus the virtual source.
-double edge_pair_term(const PlaneSource& real, const PlaneSource& virt, double sigma_tr,
-                      const Vec2d& a, const Vec2d& b, const FormFactorOptions& options,
-                      FormFactorCounters* counters) {
-  const Vec2d pa = a - real.pole, pb = b - real.pole;
-  const double L = (b - a).norm();
-  if (!(L > 0)) return 0;
-  const Vec2d u = (b - a) / L;
-  const double R = cross2(pa, u);
-  const double t1 = pa.dot(u), t2 = t1 + L;
-  if (std::abs(R) <= 1e-12 * (std::abs(t1) + std::abs(t2) + L)) return 0;  // as edge_term
-  const double dtheta = std::atan2(cross2(pa, pb), pa.dot(pb));
-  const double I1 = (real.z * std::exp(-sigma_tr * real.H) / real.H +
-                     virt.z * std::exp(-sigma_tr * virt.H) / virt.H) *
-                    dtheta;
+// F of N channels whose sources all share one pole (kChord), `active` the channels that scatter:
+// per channel alpha' / (4 pi) x the sum over edges of Gamma_e of the real plus the virtual
+// source.
+template <std::size_t N>
+std::array<double, N> shared_pole_form_factor(
+    const std::array<const materials::DiffusionCoefficients<double>*, N>& c,
+    const std::array<std::array<PlaneSource, 2>, N>& sources, unsigned active,
+    std::span<const Vec2d> edge_starts, std::span<const Vec2d> edge_ends,
+    const FormFactorOptions& options, FormFactorCounters* counters) {
+  // I1's per-source factor z e^(-sigma H) / H does not depend on the edge.
+  std::array<std::array<double, 2>, N> I1_factor{};
+  SharedPoleIntegrand<N> g;
+  for (std::size_t ch = 0; ch < N; ++ch) {
+    if (!(active >> ch & 1u)) continue;
+    g.sigma[ch] = c[ch]->sigma_tr;
+    for (std::size_t k = 0; k < 2; ++k) {
+      const PlaneSource& s = sources[ch][k];
+      I1_factor[ch][k] = s.z * std::exp(-c[ch]->sigma_tr * s.H) / s.H;
+      g.H2[ch][k] = s.H * s.H;
+    }
+  }
+  const Vec2d pole = sources[0][0].pole;
+  std::array<double, N> sum{};
   long segments = 0;
-  const PairIntegrand g{{R * R, real.H * real.H, sigma_tr}, {R * R, virt.H * virt.H, sigma_tr}};
-  const auto I2 = integrate_pair(g, R, t1, t2, 0, options, segments);
+  for (std::size_t e = 0; e < edge_starts.size(); ++e) {
+    const Vec2d& a = edge_starts[e];
+    const Vec2d& b = edge_ends[e];
+    const Vec2d pa = a - pole, pb = b - pole;
+    const double L = (b - a).norm();
+    if (!(L > 0)) continue;
+    const Vec2d u = (b - a) / L;
+    const double R = cross2(pa, u);
+    const double t1 = pa.dot(u), t2 = t1 + L;
+    if (std::abs(R) <= 1e-12 * (std::abs(t1) + std::abs(t2) + L)) continue;  // as edge_term
+    const double dtheta = std::atan2(cross2(pa, pb), pa.dot(pb));
+    g.R2 = R * R;
+    SourceSums<N> I2;
+    integrate_shared_pole(g, R, t1, t2, 0, active, options, segments, I2);
+    for (std::size_t ch = 0; ch < N; ++ch) {
+      if (!(active >> ch & 1u)) continue;
+      const double I1 = (I1_factor[ch][0] + I1_factor[ch][1]) * dtheta;
+      sum[ch] += I1 - R * (sources[ch][0].z * I2[ch][0] + sources[ch][1].z * I2[ch][1]);
+    }
+  }
   if (counters) counters->segments += segments;
-  return I1 - R * (real.z * I2[0] + virt.z * I2[1]);
+  std::array<double, N> F{};
+  for (std::size_t ch = 0; ch < N; ++ch) {
+    if (active >> ch & 1u) F[ch] = c[ch]->alpha_prime / (4 * std::numbers::pi) * sum[ch];
+  }
+  return F;
 }
 
 }  // namespace
@@ -170,22 +233,48 @@ double edges_form_factor(const materials::DiffusionCoefficients<double>& c, cons
                          const FormFactorOptions& options, FormFactorCounters* counters) {
   if (counters) ++counters->calls;
   if (!c.scatters()) return 0;
-  PlaneSource sources[2];
-  dipole_sources(c, x_o, n_o, plane, options.placement, sources);
-  double sum = 0;
-  if (sources[0].pole == sources[1].pole) {
-    for (std::size_t e = 0; e < edge_starts.size(); ++e) {
-      sum += edge_pair_term(sources[0], sources[1], c.sigma_tr, edge_starts[e], edge_ends[e],
-                            options, counters);
-    }
-    return c.alpha_prime / (4 * std::numbers::pi) * sum;
+  std::array<std::array<PlaneSource, 2>, 1> sources;
+  dipole_sources(c, x_o, n_o, plane, options.placement, sources[0].data());
+  if (sources[0][0].pole == sources[0][1].pole) {
+    return shared_pole_form_factor<1>({&c}, sources, 1u, edge_starts, edge_ends, options,
+                                      counters)[0];
   }
-  for (const PlaneSource& s : sources) {
+  double sum = 0;
+  for (const PlaneSource& s : sources[0]) {
     for (std::size_t e = 0; e < edge_starts.size(); ++e) {
       sum += edge_term(s, c.sigma_tr, edge_starts[e], edge_ends[e], options, counters);
     }
   }
   return c.alpha_prime / (4 * std::numbers::pi) * sum;
+}
+
+std::array<double, 3> edges_form_factor_rgb(
+    const std::array<materials::DiffusionCoefficients<double>, 3>& c, const Vec3d& x_o,
+    const Vec3d& n_o, const PlaneFrame& plane, std::span<const Vec2d> edge_starts,
+    std::span<const Vec2d> edge_ends, const FormFactorOptions& options,
+    FormFactorCounters* counters) {
+  std::array<double, 3> F{};
+  if (options.placement != DipolePlacement::kChord) {  // the poles differ between channels
+    for (std::size_t ch = 0; ch < 3; ++ch) {
+      F[ch] = edges_form_factor(c[ch], x_o, n_o, plane, edge_starts, edge_ends, options, counters);
+    }
+    return F;
+  }
+  if (counters) counters->calls += 3;
+  std::array<std::array<PlaneSource, 2>, 3> sources;
+  unsigned active = 0;
+  for (std::size_t ch = 0; ch < 3; ++ch) {
+    if (!c[ch].scatters()) continue;
+    active |= 1u << ch;
+    dipole_sources(c[ch], x_o, n_o, plane, options.placement, sources[ch].data());
+  }
+  if (!active) return F;
+  // A channel that does not scatter has no sources; the pole is any other's.
+  for (std::size_t ch = 0; ch < 3; ++ch) {
+    if (!(active >> ch & 1u)) sources[ch] = sources[std::size_t(std::countr_zero(active))];
+  }
+  return shared_pole_form_factor<3>({&c[0], &c[1], &c[2]}, sources, active, edge_starts, edge_ends,
+                                    options, counters);
 }
 
 double triangle_form_factor(const materials::DiffusionCoefficients<double>& c, const Vec3d& x_o,

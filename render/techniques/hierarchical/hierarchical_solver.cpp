@@ -163,11 +163,8 @@ struct Solver::Impl {
       starts[std::size_t(k)] = plane.project(P[std::size_t(ed[0])]);
       ends[std::size_t(k)] = plane.project(P[std::size_t(ed[1])]);
     }
-    for (int ch = 0; ch < 3; ++ch) {
-      F[std::size_t(ch)] = edges_form_factor(c[std::size_t(ch)], R.midpoint, R.normal, plane,
-                                             starts, ends, o.form_factor, &t.form_factor);
-    }
-    return F;
+    return edges_form_factor_rgb(c, R.midpoint, R.normal, plane, starts, ends, o.form_factor,
+                                 &t.form_factor);
   }
 
   // The oracle from (r, e) down; `emit` receives every link made, depth first.

@@ -30,6 +30,7 @@
 // polygon's plane (H -> 0): its H is floored at 1e-3 z_r there (a guard, named).
 #pragma once
 
+#include <array>
 #include <span>
 #include <string>
 
@@ -97,6 +98,16 @@ double edges_form_factor(const materials::DiffusionCoefficients<double>& c, cons
                          const Vec3d& n_o, const PlaneFrame& plane,
                          std::span<const Vec2d> edge_starts, std::span<const Vec2d> edge_ends,
                          const FormFactorOptions& options, FormFactorCounters* counters = nullptr);
+
+/// edges_form_factor of the three colour channels at once, bit for bit the same values and
+/// counts: with the chord placement their six sources share the pole, so each edge's geometry,
+/// angle and subdivision traversal are computed once (a channel's own L sigma_tr < c still decides
+/// where it stops splitting); other placements call edges_form_factor per channel.
+std::array<double, 3> edges_form_factor_rgb(
+    const std::array<materials::DiffusionCoefficients<double>, 3>& c, const Vec3d& x_o,
+    const Vec3d& n_o, const PlaneFrame& plane, std::span<const Vec2d> edge_starts,
+    std::span<const Vec2d> edge_ends, const FormFactorOptions& options,
+    FormFactorCounters* counters = nullptr);
 
 /// F(triangle abc, x_o): the triangle's own plane, its winding (a, b, c) giving the normal.
 double triangle_form_factor(const materials::DiffusionCoefficients<double>& c, const Vec3d& x_o,
