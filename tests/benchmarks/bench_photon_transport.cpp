@@ -2,8 +2,10 @@
 // slab, normal incidence, one channel: marble red (sigma_a 0.0021, sigma_s' 2.19 /mm, eta 1.5),
 // potato red (0.0024, 0.68 /mm, eta 1.3), both isotropic as the library gives them, and soy milk
 // blue (0.0034, sigma_s 0.456 /mm, g 0.832, eta 1.3: Henyey-Greenstein scattering). Reference:
-// MCML 1.2.2 does ~1.4e4 (marble) and ~3.2e4 (potato) photons per CPU-second on these, ~9e6 and
-// ~8e6 interactions per CPU-second (its cost a collision hardly depends on g: it always rotates).
+// MCML 1.2 (github:bipy/MCML, gcc 12 -O3), timed on this project's 2-core VM on the same media, does
+// 2.9e4 (marble), 7.6e4 (potato) and 5.1e4 (soy milk) photons per CPU-second, 17-19M interactions
+// (notebooks_data/bench/photon_transport_bench.sh; an earlier comment here said 1.4e4 and 3.2e4,
+// half of what it does here).
 //
 // items_per_second is photons per second: CPU time of the calling thread for threads=1 (the work
 // runs on it), wall-clock time for threads=2 (UseRealTime; divide by 2 for photons per CPU-second).
