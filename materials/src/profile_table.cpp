@@ -214,31 +214,31 @@ std::string radial_profile_csv(const Material& material, const RadialProfileOpti
   }
   if (options.total) {
     out << "# total=";
-    for (int channel = 0; channel < 3; ++channel) {
-      const Medium<double> medium = material.medium(channel);
-      double total = 0.0;
-      if (options.model == DiffusionModel::kDipole) {
-        total = StandardDipole<double>(medium).total_diffuse_reflectance();
-      } else if (options.model == DiffusionModel::kTabulated) {
-        radial_profile_value(material, channel, options.model, options.quantity, 1.0);  // range
-        total = TabulatedModel<double>(*radial_profile_for(medium.g, medium.eta), medium)
-                    .total_diffuse_reflectance();
-      } else {
-        const auto c = derive_coefficients(medium);
-        if (c.scatters()) {
-          total = integrate_over_plane(
-              [&](double r) {
-                return radial_profile_value(material, channel, options.model,
-                                            TableQuantity::kExitance, r);
-              },
-              c.z_r, 1e-9);
-        }
-      }
-      out << (channel ? "," : "") << format_number(total);
-    }
+    for (int channel = 0; channel < 3; ++channel)
+      out << (channel ? "," : "")
+          << format_number(total_diffuse_reflectance(material, channel, options.model));
     out << '\n';
   }
   return out.str() + rows.str();
+}
+
+double total_diffuse_reflectance(const Material& material, int channel, DiffusionModel model) {
+  const Medium<double> medium = material.medium(channel);
+  if (model == DiffusionModel::kDipole)
+    return StandardDipole<double>(medium).total_diffuse_reflectance();
+  if (model == DiffusionModel::kTabulated) {
+    // The value at 1 mm checks the table covers the medium (a clear error when it does not).
+    radial_profile_value(material, channel, model, TableQuantity::kExitance, 1.0);
+    return TabulatedModel<double>(*radial_profile_for(medium.g, medium.eta), medium)
+        .total_diffuse_reflectance();
+  }
+  const auto c = derive_coefficients(medium);
+  if (!c.scatters()) return 0.0;
+  return integrate_over_plane(
+      [&](double r) {
+        return radial_profile_value(material, channel, model, TableQuantity::kExitance, r);
+      },
+      c.z_r, 1e-9);
 }
 
 std::vector<BssrdfConfig> read_bssrdf_configs(std::istream& in, const std::string& source) {

@@ -57,6 +57,10 @@ std::string radial_profile_csv(const Material& material, const RadialProfileOpti
 double radial_profile_value(const Material& material, int channel, DiffusionModel model,
                             TableQuantity quantity, double r_mm);
 
+/// The total diffuse reflectance of one channel, per unit power entering (what `--total` writes):
+/// closed form for the dipole, the table's for tabulated, quadrature over the plane for the ddipole.
+double total_diffuse_reflectance(const Material& material, int channel, DiffusionModel model);
+
 /// One BSSRDF configuration: positions in mm, unit normals and light direction.
 struct BssrdfConfig {
   Vec3<double> x_i, n_i, w_i, x_o, n_o;
