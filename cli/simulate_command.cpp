@@ -38,55 +38,6 @@ struct SimulateArguments {
   acquire::SimulateOptions options;
 };
 
-// The default field: wide enough for a fit to see 3.5 diffusion lengths (1 / sigma_tr), or 5
-// transport mean free paths, of the slowest-falling channel beyond its exclusion radius, pixels a quarter of the shortest transport
-// mean free path (0.02..0.1 mm, coarser when the field would pass 1024 pixels). The fit warns below
-// 3 diffusion lengths; the old fixed 12.8 mm field gave marble 0.7 and a -8% sigma_a.
-struct Field {
-  int size = 0;
-  double pixel_mm = 0;
-  std::string why;
-};
-
-Field default_field(const materials::Material& m, int size, double pixel_mm, bool size_given,
-                    bool pixel_given) {
-  constexpr double kDiffusionLengths = 3.5, kMaxHalfWidthMm = 100;
-  constexpr int kMaxSize = 1024;
-  double half_width = 0, shortest_mfp = INFINITY;
-  int slowest = -1;
-  for (int c = 0; c < 3; ++c) {
-    const double sa = m.sigma_a[c], ss = m.sigma_s_reduced[c];
-    if (!(ss > 0)) continue;  // does not scatter: no profile to see
-    const double st = sa + ss, sigma_tr = std::sqrt(3 * sa * st);
-    shortest_mfp = std::min(shortest_mfp, 1 / st);
-    // Beyond the fit's default exclusion (a tenth of a transport mean free path), and at least 5
-    // transport mean free paths (near black, where 3.5 diffusion lengths are 2 of them).
-    const double need =
-        std::max(kDiffusionLengths / std::max(sigma_tr, 1e-300), 5 / st) + 0.1 / st;
-    if (need > half_width) half_width = need, slowest = c;
-  }
-  Field f{size, pixel_mm, ""};
-  if (slowest < 0 || (size_given && pixel_given)) return f;
-  half_width = std::min(half_width, kMaxHalfWidthMm);
-  if (!pixel_given) f.pixel_mm = std::clamp(0.25 * shortest_mfp, 0.02, 0.1);
-  if (!size_given) {
-    double n = std::ceil(2 * half_width / f.pixel_mm);
-    if (n > kMaxSize && !pixel_given) f.pixel_mm = 2 * half_width / kMaxSize, n = kMaxSize;
-    f.size = int(std::clamp(n, 64.0, double(kMaxSize)));
-  }
-  const double sa = m.sigma_a[slowest], st = sa + m.sigma_s_reduced[slowest];
-  std::ostringstream why;
-  why.precision(3);
-  why << "simulate: field " << f.size * f.pixel_mm << " mm (" << f.size << " pixels of "
-      << f.pixel_mm << " mm), sized for " << "RGB"[slowest] << ", the slowest-falling channel ("
-      << "1/sigma_tr = " << 1 / std::sqrt(3 * sa * st) << " mm; the half-width holds "
-      << f.size * f.pixel_mm / 2 * std::sqrt(3 * sa * st) << " of them"
-      << (half_width >= kMaxHalfWidthMm ? ", capped at 100 mm" : "")
-      << "); --size and --pixel-mm choose";
-  f.why = why.str();
-  return f;
-}
-
 // "1/1000,1/250,0.5" -> seconds.
 std::vector<double> parse_exposures(const std::string& text) {
   std::vector<double> times;
@@ -122,8 +73,8 @@ std::vector<double> parse_exposures(const std::string& text) {
 void run(SimulateArguments& args) {
   acquire::SimulateOptions& o = args.options;
   o.material = materials::load_material(args.material);
-  const Field field = default_field(o.material, o.transport.size, o.transport.pixel_mm,
-                                    args.size_given, args.pixel_given);
+  const acquire::SimulationField field = acquire::default_simulation_field(
+      o.material, o.transport.size, o.transport.pixel_mm, args.size_given, args.pixel_given);
   o.transport.size = field.size;
   o.transport.pixel_mm = field.pixel_mm;
   if (args.bracket_format == "png")

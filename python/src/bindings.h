@@ -24,5 +24,7 @@ using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
 void bind_materials(py::module_& m);
 void bind_profiles(py::module_& m);
 void bind_fit(py::module_& m);
+void bind_simulate(py::module_& m);
+void bind_render(py::module_& m);
 
 }  // namespace lucent::python

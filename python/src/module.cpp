@@ -30,4 +30,6 @@ PYBIND11_MODULE(_lucent, m) {
   lp::bind_materials(m);
   lp::bind_profiles(m);
   lp::bind_fit(m);
+  lp::bind_simulate(m);
+  lp::bind_render(m);
 }

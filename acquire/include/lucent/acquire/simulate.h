@@ -83,4 +83,17 @@ imaging::ImageRgb white_reference_radiance(int size, double pixel_mm, double rho
 imaging::ImageRgb apply_lens(const imaging::ImageRgb& image, double pixel_mm, double blur_mm,
                              double glare, double glare_radius_mm);
 
+/// The default field of a simulated capture (`lucent simulate` without --size or --pixel-mm): wide
+/// enough for a fit to see 3.5 diffusion lengths (1 / sigma_tr), or 5 transport mean free paths, of
+/// the slowest-falling channel beyond its exclusion radius; pixels a quarter of the shortest
+/// transport mean free path (0.02..0.1 mm, coarser when the field would pass 1024 pixels). What is
+/// given is kept; `why` says what was chosen ("" when nothing was).
+struct SimulationField {
+  int size = 0;
+  double pixel_mm = 0;
+  std::string why;
+};
+SimulationField default_simulation_field(const materials::Material& material, int size,
+                                         double pixel_mm, bool size_given, bool pixel_given);
+
 }  // namespace lucent::acquire
