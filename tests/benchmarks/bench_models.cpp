@@ -1,13 +1,19 @@
-// Evaluations per second of the standard and directional dipole, double and float, one thread.
+// Evaluations per second of the standard and directional dipole, double and float, one thread; and
+// the radial profile of a material (materials::radial_profile_value, what `lucent profile` and the
+// Python module's lucent.profile evaluate) at 10^6 radii, three channels: the C++ side of the
+// module's calling overhead (notebooks_data/bench/python_overhead.py).
 // Run: build/release-or-ci/tests/benchmarks/bench_models --benchmark_repetitions=5
 //        --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <random>
 #include <vector>
 
 #include "lucent/materials/dipole.h"
 #include "lucent/materials/directional_dipole.h"
+#include "lucent/materials/material.h"
+#include "lucent/materials/profile_table.h"
 
 namespace lm = lucent::materials;
 
@@ -72,4 +78,26 @@ BENCHMARK(BM_StandardDipole<double>);
 BENCHMARK(BM_StandardDipole<float>);
 BENCHMARK(BM_DirectionalDipole<double>);
 BENCHMARK(BM_DirectionalDipole<float>);
+// 10^6 radii log-spaced over 0.01-50 mm, marble, R, G and B: one call per radius and channel.
+void BM_RadialProfile(benchmark::State& state) {
+  const auto model = static_cast<lm::DiffusionModel>(state.range(0));
+  const lm::Material marble = lm::load_material("marble");
+  constexpr int kRadii = 1'000'000;
+  std::vector<double> r(kRadii), out(3 * std::size_t(kRadii));
+  for (int i = 0; i < kRadii; ++i) r[i] = 0.01 * std::pow(5000.0, double(i) / (kRadii - 1));
+  for (auto _ : state) {
+    for (int i = 0; i < kRadii; ++i)
+      for (int c = 0; c < 3; ++c)
+        out[3 * std::size_t(i) + c] = lm::radial_profile_value(
+            marble, c, model, lm::TableQuantity::kExitance, r[std::size_t(i)]);
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(state.iterations() * kRadii);
+  state.SetLabel(lm::to_string(model));
+}
+BENCHMARK(BM_RadialProfile)
+    ->Arg(int(lm::DiffusionModel::kDipole))
+    ->Arg(int(lm::DiffusionModel::kTabulated))
+    ->Unit(benchmark::kMillisecond);
+
 BENCHMARK_MAIN();
