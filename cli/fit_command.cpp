@@ -51,26 +51,10 @@ struct FitArguments {
 
 fit::FitOptions to_options(const FitArguments& a) {
   fit::FitOptions o;
-  if (a.model == "dipole")
-    o.model = fit::FitModel::kDipole;
-  else if (a.model == "ddipole")
-    o.model = fit::FitModel::kDirectionalDipole;
-  else if (a.model == "tabulated")
-    o.model = fit::FitModel::kTabulated;
-  else if (a.model == "auto")
-    o.model = fit::FitModel::kAuto;
-  else
-    throw Error("--model: expected auto, tabulated, dipole or ddipole, got '" + a.model + "'");
+  o.model = fit::parse_fit_model(a.model);
   if (!(a.g >= 0 && a.g <= 0.99)) throw Error("--g: expected a Henyey-Greenstein g in [0, 0.99]");
   o.g = a.g;
-  if (a.quality == "fast")
-    o.quality = fit::Quality::kFast;
-  else if (a.quality == "balanced")
-    o.quality = fit::Quality::kBalanced;
-  else if (a.quality == "accurate")
-    o.quality = fit::Quality::kAccurate;
-  else
-    throw Error("--quality: expected fast, balanced or accurate, got '" + a.quality + "'");
+  o.quality = fit::parse_quality(a.quality);
   if (a.loss == "none") {
     o.loss = fit::LossKind::kNone;
   } else {

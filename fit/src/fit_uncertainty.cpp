@@ -6,9 +6,25 @@
 #include <numbers>
 #include <sstream>
 
+#include "lucent/core/error.h"
 #include "model_prediction.h"
 
 namespace lucent::fit {
+
+FitModel parse_fit_model(const std::string& name, const std::string& option) {
+  if (name == "auto") return FitModel::kAuto;
+  if (name == "tabulated") return FitModel::kTabulated;
+  if (name == "dipole") return FitModel::kDipole;
+  if (name == "ddipole") return FitModel::kDirectionalDipole;
+  throw Error(option + ": expected auto, tabulated, dipole or ddipole, got '" + name + "'");
+}
+
+Quality parse_quality(const std::string& name, const std::string& option) {
+  if (name == "fast") return Quality::kFast;
+  if (name == "balanced") return Quality::kBalanced;
+  if (name == "accurate") return Quality::kAccurate;
+  throw Error(option + ": expected fast, balanced or accurate, got '" + name + "'");
+}
 
 std::string to_string(FitModel m) {
   switch (m) {

@@ -33,22 +33,10 @@ struct FitKeywords {
 // The options `lucent fit` makes of its flags (cli/fit_command.cpp to_options), named as here.
 FitOptions to_options(const FitKeywords& k) {
   FitOptions o;
-  if (k.model == "dipole")
-    o.model = fit::FitModel::kDipole;
-  else if (k.model == "ddipole")
-    o.model = fit::FitModel::kDirectionalDipole;
-  else if (k.model == "tabulated")
-    o.model = fit::FitModel::kTabulated;
-  else if (k.model != "auto")
-    throw Error("model: expected auto, tabulated, dipole or ddipole, got '" + k.model + "'");
+  o.model = fit::parse_fit_model(k.model, "model");
   if (!(k.g >= 0 && k.g <= 0.99)) throw Error("g: expected a Henyey-Greenstein g in [0, 0.99]");
   o.g = k.g;
-  if (k.quality == "fast")
-    o.quality = fit::Quality::kFast;
-  else if (k.quality == "accurate")
-    o.quality = fit::Quality::kAccurate;
-  else if (k.quality != "balanced")
-    throw Error("quality: expected fast, balanced or accurate, got '" + k.quality + "'");
+  o.quality = fit::parse_quality(k.quality, "quality");
   if (k.loss == "huber")
     o.loss = fit::LossKind::kHuber;
   else if (k.loss == "cauchy")

@@ -27,7 +27,11 @@ namespace lucent::fit {
 /// model is adequate.
 enum class FitModel { kDipole, kDirectionalDipole, kTabulated, kAuto };
 std::string to_string(FitModel model);
+/// "auto", "tabulated", "dipole" or "ddipole"; anything else throws lucent::Error naming `option`.
+FitModel parse_fit_model(const std::string& name, const std::string& option = "--model");
 enum class Quality { kFast, kBalanced, kAccurate };
+/// "fast", "balanced" or "accurate"; anything else throws lucent::Error naming `option`.
+Quality parse_quality(const std::string& name, const std::string& option = "--quality");
 enum class LossKind { kNone, kHuber, kCauchy };
 
 struct FitOptions {
